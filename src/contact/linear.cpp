@@ -1,0 +1,103 @@
+#include "contact/linear.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace rocklab::linear {
+
+void apply_deformability(LinearProps& p, int dim, double R1, double R2, bool ball_facet) {
+  if (p.emod <= 0)
+    return;
+  const double r = ball_facet ? R1 : std::min(R1, R2);
+  const double area =
+      p.user_area > 0 ? p.user_area : (dim == 2 ? 2.0 * r : std::numbers::pi * r * r);
+  const double L = ball_facet ? R1 : R1 + R2;
+  p.kn = area * p.emod / L;
+  p.ks = p.kratio > 0 ? p.kn / p.kratio : 0.0;
+}
+
+void update_linear_part(const LinearProps& p, LinearState& s, const ContactKinematics& k,
+                        EventSink& events, bool slip_allowed) noexcept {
+  const double gs = k.gap - p.rgap; // surface gap of the linear interface
+  // Normal force, tension positive; the linear interface carries no tension.
+  if (p.lin_mode == 0)
+    s.Fn = p.kn * gs;
+  else
+    s.Fn = s.Fn + p.kn * k.d_dn;
+  s.Fn = std::min(s.Fn, 0.0);
+
+  // Shear force: trial increment, then the Coulomb limit F_s^mu = -mu Fn.
+  const double F0ss = s.Fss, F0st = s.Fst;
+  double tss = F0ss - p.ks * k.d_dss;
+  double tst = F0st - p.ks * k.d_dst;
+  const double limit = -p.fric * s.Fn;
+  const double trial = std::hypot(tss, tst);
+  const bool slipping = slip_allowed && trial > limit;
+  if (slipping) {
+    const double scale = trial > 0 ? limit / trial : 0.0;
+    tss *= scale;
+    tst *= scale;
+  }
+  s.Fss = tss;
+  s.Fst = tst;
+  // Slip energy: the part of the shear increment not taken up elastically does friction work.
+  if (p.ks > 0) {
+    const double dk_ss = -(s.Fss - F0ss) / p.ks, dk_st = -(s.Fst - F0st) / p.ks;
+    const double dmu_ss = k.d_dss - dk_ss, dmu_st = k.d_dst - dk_st;
+    s.E_slip -= 0.5 * ((F0ss + s.Fss) * dmu_ss + (F0st + s.Fst) * dmu_st);
+  }
+  if (slipping != s.slip) {
+    Event e;
+    e.type = EventType::SlipChange;
+    e.mode = slipping ? 0 : 1;
+    events.raise(e);
+    s.slip = slipping;
+  }
+}
+
+void update(LinearContact& c, const ContactKinematics& k, ContactResult& out,
+            EventSink& events) noexcept {
+  const LinearProps& p = c.p;
+  LinearState& s = c.s;
+  const double gs = k.gap - p.rgap;
+  const bool active = gs <= 0.0;
+  if (!active) {
+    // Inactive: the force-displacement law is skipped and the forces vanish.
+    if (s.slip) {
+      Event e;
+      e.type = EventType::SlipChange;
+      e.mode = 1;
+      events.raise(e);
+    }
+    s = LinearState{.E_slip = s.E_slip, .E_dashpot = s.E_dashpot};
+    out = ContactResult{};
+    return;
+  }
+  s.active = true;
+  update_linear_part(p, s, k, events);
+
+  // Dashpots: F_n^d = 2 beta_n sqrt(m_c kn) v_n (opposes opening), shear opposes sliding.
+  double Fdn = 0, Fdss = 0, Fdst = 0;
+  if (k.dt > 0 && (p.dp_nratio > 0 || p.dp_sratio > 0)) {
+    const double cn = 2.0 * p.dp_nratio * std::sqrt(k.mass_eff * p.kn);
+    const double cs = 2.0 * p.dp_sratio * std::sqrt(k.mass_eff * p.ks);
+    Fdn = cn * k.d_dn / k.dt;
+    Fdss = -cs * k.d_dss / k.dt;
+    Fdst = -cs * k.d_dst / k.dt;
+    const bool no_tension = p.dp_mode == 1 || p.dp_mode == 3;
+    const bool slip_cut = p.dp_mode == 2 || p.dp_mode == 3;
+    if (no_tension && s.Fn + Fdn > 0)
+      Fdn = -s.Fn;
+    if (slip_cut && s.slip)
+      Fdss = Fdst = 0;
+    // Dissipation: minus the work of the dashpot force on the relative displacement.
+    s.E_dashpot -= -Fdn * k.d_dn + Fdss * k.d_dss + Fdst * k.d_dst;
+  }
+  s.Fdn = Fdn;
+  s.Fdss = Fdss;
+  s.Fdst = Fdst;
+  out = ContactResult{s.Fn + Fdn, s.Fss + Fdss, s.Fst + Fdst, 0, 0, 0};
+}
+
+} // namespace rocklab::linear

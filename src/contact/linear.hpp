@@ -1,0 +1,80 @@
+// Linear contact model (PFC `linear`): linear springs with Coulomb slip and optional dashpots.
+// The linear component is also the first interface of the linear parallel bond model
+// (linear-parallel-bond-model.md, Eq. 1), where the formulation is referenced.
+#pragma once
+
+#include "contact/contact_model.hpp"
+
+#include <cstdint>
+
+namespace rocklab {
+
+struct LinearProps {
+  double kn = 0;        ///< normal stiffness [N/m]
+  double ks = 0;        ///< shear stiffness [N/m]
+  double fric = 0;      ///< friction coefficient mu [-]
+  double rgap = 0;      ///< reference gap g_r [m]
+  int lin_mode = 0;     ///< normal-force update: 0 absolute, 1 incremental
+  double dp_nratio = 0; ///< normal critical damping ratio beta_n [-], [0, 1]
+  double dp_sratio = 0; ///< shear critical damping ratio beta_s [-], [0, 1]
+  int dp_mode = 0;      ///< 0 full; 1 no-tension normal; 2 slip-cut shear; 3 both
+  double emod = 0;      ///< effective modulus E* [Pa], > 0 selects the deformability method
+  double kratio = 0;    ///< normal-to-shear stiffness ratio kappa* [-] (deformability method)
+  double user_area = 0; ///< constant area for deformability [m^2], 0 = from the radii
+};
+
+struct LinearState {
+  double Fn = 0;                      ///< linear normal force, > 0 tension [N]
+  double Fss = 0;                     ///< linear shear force along s_c [N]
+  double Fst = 0;                     ///< linear shear force along t_c [N]
+  double Fdn = 0, Fdss = 0, Fdst = 0; ///< dashpot force components [N]
+  bool slip = false;
+  bool active = false;
+  double E_slip = 0;    ///< accumulated slip dissipation [J]
+  double E_dashpot = 0; ///< accumulated dashpot dissipation [J]
+};
+
+struct LinearContact {
+  LinearProps p;
+  LinearState s;
+};
+
+namespace linear {
+
+/// Apply the deformability method: kn = A E* / L, ks = kn / kappa* (kappa* = 0 gives ks = 0).
+/// A = 2 r (2D, unit thickness) or pi r^2 (3D), r = min(R1, R2) (R1 for ball-facet);
+/// L = R1 + R2 (R1 for ball-facet). Same construction as the pbond's Eq. 16.
+void apply_deformability(LinearProps& p, int dim, double R1, double R2, bool ball_facet);
+
+/// Force-displacement update of the linear and dashpot components.
+void update(LinearContact& c, const ContactKinematics& k, ContactResult& out,
+            EventSink& events) noexcept;
+
+/// Update of the linear component only, written so bonded models can reuse it:
+/// returns the linear force in `s` and accumulates slip energy. `slip_allowed` is false for
+/// models that suppress slip while bonded.
+void update_linear_part(const LinearProps& p, LinearState& s, const ContactKinematics& k,
+                        EventSink& events, bool slip_allowed = true) noexcept;
+
+inline ContactStiffness stiffness(const LinearContact& c) {
+  return {c.p.kn + c.p.ks, c.p.ks, 0.0};
+}
+
+inline ContactEnergy energy(const LinearContact& c) {
+  ContactEnergy e;
+  if (c.p.kn > 0)
+    e.strain += 0.5 * c.s.Fn * c.s.Fn / c.p.kn;
+  if (c.p.ks > 0)
+    e.strain += 0.5 * (c.s.Fss * c.s.Fss + c.s.Fst * c.s.Fst) / c.p.ks;
+  e.slip = c.s.E_slip;
+  e.dashpot = c.s.E_dashpot;
+  return e;
+}
+
+/// The linear model never holds a contact alive beyond the proximity margin.
+inline bool keeps_alive(const LinearContact&) {
+  return false;
+}
+
+} // namespace linear
+} // namespace rocklab

@@ -1,0 +1,63 @@
+// Balls (2D unit-thickness disks or 3D spheres) stored as structure-of-arrays.
+#pragma once
+
+#include "core/types.hpp"
+
+#include <numbers>
+#include <string>
+#include <vector>
+
+namespace rocklab {
+
+/// All balls of a model. Index i addresses the same ball in every array.
+struct Balls {
+  std::vector<Vec3> pos;            ///< centre position [m]
+  std::vector<Vec3> vel;            ///< translational velocity [m/s] (at the half step)
+  std::vector<Vec3> spin;           ///< rotational velocity [rad/s] (at the half step)
+  std::vector<Vec3> force;          ///< resultant contact force of the current step [N]
+  std::vector<Vec3> moment;         ///< resultant contact moment of the current step [N m]
+  std::vector<Vec3> applied_force;  ///< user-applied external force [N]
+  std::vector<Vec3> applied_moment; ///< user-applied external moment [N m]
+  std::vector<Vec3> disp;           ///< displacement since the last contact detection [m]
+  std::vector<double> radius;       ///< radius [m]
+  std::vector<double> mass;         ///< mass [kg]
+  std::vector<double> inertia;      ///< moment of inertia about any centroidal axis [kg m^2]
+  std::vector<double> density;      ///< density [kg/m^3]
+  std::vector<std::uint8_t> fixity; ///< bit set of fixed DOFs (see Dof): velocity held constant
+  std::vector<std::int32_t> group;  ///< index into the model's group-name table
+  std::vector<std::int64_t> id;     ///< user id, unique
+
+  std::size_t size() const { return pos.size(); }
+
+  /// Append a ball; mass and inertia follow from density (2D: unit-thickness disk).
+  std::size_t add(int dim, std::int64_t user_id, const Vec3& x, double r, double rho,
+                  std::int32_t group_index) {
+    const double pi = std::numbers::pi;
+    double m = 0, inert = 0;
+    if (dim == 2) {
+      m = rho * pi * r * r; // unit thickness
+      inert = 0.5 * m * r * r;
+    } else {
+      m = rho * 4.0 / 3.0 * pi * r * r * r;
+      inert = 0.4 * m * r * r;
+    }
+    pos.push_back(x);
+    vel.push_back(Vec3::Zero());
+    spin.push_back(Vec3::Zero());
+    force.push_back(Vec3::Zero());
+    moment.push_back(Vec3::Zero());
+    applied_force.push_back(Vec3::Zero());
+    applied_moment.push_back(Vec3::Zero());
+    disp.push_back(Vec3::Zero());
+    radius.push_back(r);
+    mass.push_back(m);
+    inertia.push_back(inert);
+    density.push_back(rho);
+    fixity.push_back(0);
+    group.push_back(group_index);
+    id.push_back(user_id);
+    return pos.size() - 1;
+  }
+};
+
+} // namespace rocklab

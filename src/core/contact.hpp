@@ -1,0 +1,39 @@
+// A contact between two pieces: the contact plane (FJ memo Eq. 2-6) and the resulting force.
+#pragma once
+
+#include "contact/registry.hpp"
+#include "core/types.hpp"
+
+#include <cstdint>
+
+namespace rocklab {
+
+enum class ContactKind : std::uint8_t { BallBall = 0, BallFacet = 1 };
+
+/// Ordering key: contacts are kept sorted by it, which makes every loop order deterministic.
+inline std::uint64_t contact_key(ContactKind kind, std::int32_t end1, std::int32_t end2) {
+  return (static_cast<std::uint64_t>(end1) << 32) | (static_cast<std::uint64_t>(kind) << 31) |
+         static_cast<std::uint32_t>(end2);
+}
+
+struct Contact {
+  std::uint64_t key = 0;
+  std::int32_t end1 = -1;  ///< ball index
+  std::int32_t end2 = -1;  ///< ball index (ball-ball) or wall index (ball-facet)
+  std::int32_t facet = -1; ///< nearest facet of the wall (ball-facet)
+  ContactKind kind = ContactKind::BallBall;
+  ModelKind model = ModelKind::Linear;
+  std::uint32_t slot = 0; ///< index into the model's batch
+  bool initialized = false;
+  Vec3 xc = Vec3::Zero();     ///< contact location [m]
+  Vec3 n = Vec3::UnitX();     ///< normal, from piece 1 to piece 2
+  Vec3 s = Vec3::UnitY();     ///< contact-plane s axis
+  Vec3 t = Vec3::UnitZ();     ///< contact-plane t axis, n = s x t
+  double gap = 0;             ///< contact gap g_c, > 0 open [m]
+  Vec3 force = Vec3::Zero();  ///< force on piece 2 at xc, global [N]
+  Vec3 moment = Vec3::Zero(); ///< moment on piece 2, global [N m]
+  ContactResult local;        ///< force and moment in contact-plane coordinates
+  ContactStiffness stiff;     ///< stiffness for the time-step estimate
+};
+
+} // namespace rocklab

@@ -1,0 +1,648 @@
+#include "core/model.hpp"
+
+#include "core/geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <omp.h>
+#include <sstream>
+
+namespace rocklab {
+
+namespace {
+
+constexpr std::size_t kBlock = 2048; // fixed reduction block: sums do not depend on threads
+
+/// Sum K quantities over n items in fixed blocks, so the result is bit-identical at any thread
+/// count. f(i, acc) adds item i's contributions into acc[0..K).
+template <int K, class F> std::array<double, K> block_sum(std::size_t n, F&& f) {
+  const std::size_t nblocks = (n + kBlock - 1) / kBlock;
+  std::array<double, K> total{};
+  if (nblocks == 0)
+    return total;
+  // Small stack buffer for the common case; larger models use a heap buffer once per call.
+  constexpr std::size_t kStack = 256;
+  std::array<std::array<double, K>, kStack> stack_parts;
+  std::vector<std::array<double, K>> heap_parts;
+  std::array<double, K>* parts = stack_parts.data();
+  if (nblocks > kStack) {
+    heap_parts.resize(nblocks);
+    parts = heap_parts.data();
+  }
+#pragma omp parallel for schedule(static)
+  for (std::size_t b = 0; b < nblocks; ++b) {
+    std::array<double, K> acc{};
+    const std::size_t end = std::min(n, (b + 1) * kBlock);
+    for (std::size_t i = b * kBlock; i < end; ++i)
+      f(i, acc);
+    parts[b] = acc;
+  }
+  for (std::size_t b = 0; b < nblocks; ++b)
+    for (int k = 0; k < K; ++k)
+      total[k] += parts[b][k];
+  return total;
+}
+
+double sign(double v) {
+  return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0);
+}
+
+bool rule_matches_balls(const ModelRule& r, int ga, int gb) {
+  if (r.ball_facet)
+    return false;
+  auto m = [](int want, int g) { return want < 0 || want == g; };
+  return (m(r.group1, ga) && m(r.group2, gb)) || (m(r.group1, gb) && m(r.group2, ga));
+}
+
+bool rule_matches_facet(const ModelRule& r, int g, int wall) {
+  if (!r.ball_facet)
+    return false;
+  return (r.group1 < 0 || r.group1 == g) && (r.wall < 0 || r.wall == wall);
+}
+
+} // namespace
+
+int Model::group_index(const std::string& name) {
+  for (std::size_t i = 0; i < group_names.size(); ++i)
+    if (group_names[i] == name)
+      return static_cast<int>(i);
+  group_names.push_back(name);
+  return static_cast<int>(group_names.size() - 1);
+}
+
+void Model::initialize() {
+  const std::size_t nthreads = static_cast<std::size_t>(omp_get_max_threads());
+  thread_events_.resize(nthreads);
+  thread_keys_.resize(nthreads);
+  for (auto& w : walls)
+    w.update_bounds();
+  margin_ = settings.margin;
+  if (margin_ <= 0) {
+    double sum = 0;
+    for (double r : balls.radius)
+      sum += r;
+    margin_ = balls.size() ? 0.1 * sum / static_cast<double>(balls.size()) : 0.0;
+  }
+  detect();
+  force_displacement(0.0);
+  const EnergyLedger e = energy();
+  ledger_.initial_total = e.kinetic() + e.stored();
+  initialized_ = true;
+}
+
+bool Model::needs_detection() const {
+  return 2.0 * max_ball_disp_ + wall_disp_ >= margin_;
+}
+
+void Model::detect() {
+  const std::size_t n = balls.size();
+  const int dim = settings.dim;
+  const std::size_t nthreads = thread_keys_.size();
+  candidate_keys_.clear();
+
+  if (n > 0) {
+    // Cell grid: cells at least one interaction range wide, so only neighbour cells can pair.
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::max());
+    Vec3 hi = -lo;
+    double rmax = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      lo = lo.cwiseMin(balls.pos[i]);
+      hi = hi.cwiseMax(balls.pos[i]);
+      rmax = std::max(rmax, balls.radius[i]);
+    }
+    double cell = std::max(2.0 * rmax + margin_, 1e-300);
+    std::array<std::int64_t, 3> nc{1, 1, 1};
+    for (;;) {
+      for (int d = 0; d < dim; ++d)
+        nc[d] = static_cast<std::int64_t>((hi[d] - lo[d]) / cell) + 1;
+      if (nc[0] * nc[1] * nc[2] <= static_cast<std::int64_t>(std::max<std::size_t>(8 * n, 64)))
+        break;
+      cell *= 1.25;
+    }
+    const std::size_t ncells = static_cast<std::size_t>(nc[0] * nc[1] * nc[2]);
+    auto cell_of = [&](const Vec3& x, int axis) {
+      return std::clamp<std::int64_t>(static_cast<std::int64_t>((x[axis] - lo[axis]) / cell), 0,
+                                      nc[axis] - 1);
+    };
+    auto cell_index = [&](std::int64_t cx, std::int64_t cy, std::int64_t cz) {
+      return static_cast<std::size_t>((cz * nc[1] + cy) * nc[0] + cx);
+    };
+    cell_start_.assign(ncells + 1, 0);
+    cell_items_.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      ++cell_start_[cell_index(cell_of(balls.pos[i], 0), cell_of(balls.pos[i], 1),
+                               dim == 3 ? cell_of(balls.pos[i], 2) : 0) +
+                    1];
+    for (std::size_t c = 0; c < ncells; ++c)
+      cell_start_[c + 1] += cell_start_[c];
+    {
+      std::vector<std::int32_t>& fill = adj_items_; // reuse as a cursor buffer
+      fill.assign(cell_start_.begin(), cell_start_.end() - 1);
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t c = cell_index(cell_of(balls.pos[i], 0), cell_of(balls.pos[i], 1),
+                                         dim == 3 ? cell_of(balls.pos[i], 2) : 0);
+        cell_items_[static_cast<std::size_t>(fill[c]++)] = static_cast<std::int32_t>(i);
+      }
+    }
+
+#pragma omp parallel
+    {
+      const std::size_t tid = static_cast<std::size_t>(omp_get_thread_num());
+      std::vector<std::uint64_t>& keys = thread_keys_[tid];
+      keys.clear();
+#pragma omp for schedule(static)
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3& xi = balls.pos[i];
+        const double ri = balls.radius[i];
+        const std::size_t first = keys.size();
+        const std::int64_t cx = cell_of(xi, 0), cy = cell_of(xi, 1);
+        const std::int64_t cz = dim == 3 ? cell_of(xi, 2) : 0;
+        for (std::int64_t z = std::max<std::int64_t>(cz - 1, 0);
+             z <= std::min<std::int64_t>(cz + 1, nc[2] - 1); ++z)
+          for (std::int64_t y = std::max<std::int64_t>(cy - 1, 0);
+               y <= std::min<std::int64_t>(cy + 1, nc[1] - 1); ++y)
+            for (std::int64_t x = std::max<std::int64_t>(cx - 1, 0);
+                 x <= std::min<std::int64_t>(cx + 1, nc[0] - 1); ++x) {
+              const std::size_t c = cell_index(x, y, z);
+              for (std::int32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
+                const std::size_t j = static_cast<std::size_t>(cell_items_[k]);
+                if (j <= i)
+                  continue;
+                const double reach = ri + balls.radius[j] + margin_;
+                if ((balls.pos[j] - xi).squaredNorm() < reach * reach)
+                  keys.push_back(contact_key(ContactKind::BallBall, static_cast<std::int32_t>(i),
+                                             static_cast<std::int32_t>(j)));
+              }
+            }
+        std::sort(keys.begin() + static_cast<std::ptrdiff_t>(first), keys.end());
+        for (std::size_t w = 0; w < walls.size(); ++w) {
+          const Wall& wall = walls[w];
+          const double reach = ri + margin_;
+          if ((xi.array() < wall.lo.array() - reach).any() ||
+              (xi.array() > wall.hi.array() + reach).any())
+            continue;
+          double dmin = std::numeric_limits<double>::max();
+          for (const Facet& f : wall.facets)
+            dmin = std::min(dmin, (closest_point_on_facet(f, xi) - xi).norm());
+          if (dmin < reach)
+            keys.push_back(contact_key(ContactKind::BallFacet, static_cast<std::int32_t>(i),
+                                       static_cast<std::int32_t>(w)));
+        }
+      }
+    }
+    // Static scheduling hands out ascending index ranges in thread order, so concatenation
+    // gives the same sorted list at any thread count.
+    for (std::size_t t = 0; t < nthreads; ++t)
+      candidate_keys_.insert(candidate_keys_.end(), thread_keys_[t].begin(), thread_keys_[t].end());
+  }
+
+  // Merge the candidates with the existing contacts (both sorted by key).
+  new_contacts_.clear();
+  new_batches_.clear();
+  std::size_t a = 0, b = 0;
+  auto keep = [&](Contact c) {
+    c.slot = move_contact_data(new_batches_, batches_, c.model, c.slot);
+    new_contacts_.push_back(c);
+  };
+  auto retire = [&](const Contact& c) {
+    visit_contact(batches_, c.model, c.slot, [&](const auto& data) {
+      ContactEnergy e = contact_energy(data);
+      e.strain = e.bond_strain = 0; // stored energy leaves with the contact
+      retired_ += e;
+    });
+    Event ev;
+    ev.type = EventType::ContactDeleted;
+    ev.step = step_;
+    ev.time = time_;
+    ev.contact = c.key;
+    ev.position = c.xc;
+    ev.normal = c.n;
+    ev.gap = c.gap;
+    pending_events_.push_back(ev);
+  };
+  auto create = [&](std::uint64_t key) {
+    const auto end1 = static_cast<std::int32_t>(key >> 32);
+    const bool facet = ((key >> 31) & 1u) != 0;
+    const auto end2 = static_cast<std::int32_t>(key & 0x7fffffffu);
+    const ModelRule* rule = nullptr;
+    for (const ModelRule& r : rules) {
+      const bool ok = facet ? rule_matches_facet(r, balls.group[end1], end2)
+                            : rule_matches_balls(r, balls.group[end1], balls.group[end2]);
+      if (ok) {
+        rule = &r;
+        break;
+      }
+    }
+    if (!rule)
+      return;
+    Contact c;
+    c.key = key;
+    c.end1 = end1;
+    c.end2 = end2;
+    c.kind = facet ? ContactKind::BallFacet : ContactKind::BallBall;
+    c.model = kind_of(rule->props);
+    const double R1 = balls.radius[end1];
+    const double R2 = facet ? 0.0 : balls.radius[end2];
+    c.slot = create_contact_data(new_batches_, rule->props, settings.dim, R1, R2, facet);
+    visit_contact(new_batches_, c.model, c.slot,
+                  [&](const auto& data) { c.stiff = contact_stiffness(data); });
+    new_contacts_.push_back(c);
+    Event ev;
+    ev.type = EventType::ContactCreated;
+    ev.step = step_;
+    ev.time = time_;
+    ev.contact = key;
+    pending_events_.push_back(ev);
+  };
+  while (a < contacts_.size() || b < candidate_keys_.size()) {
+    if (b == candidate_keys_.size() ||
+        (a < contacts_.size() && contacts_[a].key < candidate_keys_[b])) {
+      const Contact& c = contacts_[a++];
+      const bool alive = visit_contact(batches_, c.model, c.slot,
+                                       [](const auto& data) { return contact_keeps_alive(data); });
+      if (alive)
+        keep(c);
+      else
+        retire(c);
+    } else if (a == contacts_.size() || candidate_keys_[b] < contacts_[a].key) {
+      create(candidate_keys_[b++]);
+    } else {
+      keep(contacts_[a++]);
+      ++b;
+    }
+  }
+  std::swap(contacts_, new_contacts_);
+  std::swap(batches_, new_batches_);
+
+  // Ball -> contact adjacency in contact order, for a deterministic force sum.
+  adj_start_.assign(n + 1, 0);
+  for (const Contact& c : contacts_) {
+    ++adj_start_[static_cast<std::size_t>(c.end1) + 1];
+    if (c.kind == ContactKind::BallBall)
+      ++adj_start_[static_cast<std::size_t>(c.end2) + 1];
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    adj_start_[i + 1] += adj_start_[i];
+  adj_items_.resize(static_cast<std::size_t>(adj_start_[n]));
+  {
+    std::vector<std::int32_t> cursor(adj_start_.begin(), adj_start_.end() - 1);
+    for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+      const Contact& c = contacts_[ci];
+      adj_items_[static_cast<std::size_t>(cursor[static_cast<std::size_t>(c.end1)]++)] =
+          static_cast<std::int32_t>(2 * ci);
+      if (c.kind == ContactKind::BallBall)
+        adj_items_[static_cast<std::size_t>(cursor[static_cast<std::size_t>(c.end2)]++)] =
+            static_cast<std::int32_t>(2 * ci + 1);
+    }
+  }
+  for (auto& d : balls.disp)
+    d.setZero();
+  max_ball_disp_ = 0;
+  wall_disp_ = 0;
+}
+
+void Model::force_displacement(double dt) {
+  const int dim = settings.dim;
+  const std::size_t nc = contacts_.size();
+  const std::size_t none = std::numeric_limits<std::size_t>::max();
+  std::size_t blowup = none;
+  for (auto& buf : thread_events_)
+    buf.clear();
+
+#pragma omp parallel reduction(min : blowup)
+  {
+    EventBuffer& events = thread_events_[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+    for (std::size_t ci = 0; ci < nc; ++ci) {
+      Contact& c = contacts_[ci];
+      const std::size_t i1 = static_cast<std::size_t>(c.end1);
+      const Vec3& x1 = balls.pos[i1];
+      const double R1 = balls.radius[i1];
+      PlaneGeometry g;
+      Vec3 xb2, v2, w2;
+      double R2 = 0, m_eff = balls.mass[i1];
+      if (c.kind == ContactKind::BallBall) {
+        const std::size_t i2 = static_cast<std::size_t>(c.end2);
+        R2 = balls.radius[i2];
+        g = ball_ball_plane(x1, R1, balls.pos[i2], R2);
+        xb2 = balls.pos[i2];
+        v2 = balls.vel[i2];
+        w2 = balls.spin[i2];
+        m_eff = balls.mass[i1] * balls.mass[i2] / (balls.mass[i1] + balls.mass[i2]);
+      } else {
+        const Wall& wall = walls[static_cast<std::size_t>(c.end2)];
+        double dmin = std::numeric_limits<double>::max();
+        Vec3 xf = Vec3::Zero();
+        for (std::size_t f = 0; f < wall.facets.size(); ++f) {
+          const Vec3 p = closest_point_on_facet(wall.facets[f], x1);
+          const double d = (p - x1).squaredNorm();
+          if (d < dmin) {
+            dmin = d;
+            xf = p;
+            c.facet = static_cast<std::int32_t>(f);
+          }
+        }
+        g = ball_facet_plane(x1, R1, xf);
+        xb2 = wall.center;
+        v2 = wall.velocity;
+        w2 = wall.spin;
+      }
+      if (!c.initialized) {
+        if (dim == 2) {
+          c.s = -Vec3::UnitZ();
+          c.t = Vec3::UnitZ().cross(g.n);
+        } else {
+          c.s = initial_s_axis(g.n);
+          c.t = g.n.cross(c.s);
+        }
+        c.initialized = true;
+      } else {
+        update_plane_axes(dim, c.n, g.n, balls.spin[i1], w2, dt, c.s, c.t);
+      }
+      c.xc = g.xc;
+      c.n = g.n;
+      c.gap = g.gap;
+      if (g.gap < -std::min(R1, c.kind == ContactKind::BallBall ? R2 : R1) || !std::isfinite(g.gap))
+        blowup = std::min(blowup, ci);
+
+      ContactKinematics k;
+      k.dt = dt;
+      k.dim = dim;
+      k.gap = g.gap;
+      k.R1 = R1;
+      k.R2 = R2;
+      k.mass_eff = m_eff;
+      k.ball_facet = c.kind == ContactKind::BallFacet;
+      relative_increments(c.xc, c.n, c.s, c.t, x1, balls.vel[i1], balls.spin[i1], xb2, v2, w2, dt,
+                          k);
+      const std::size_t first_event = events.size();
+      EventSink sink{&events, c.key, 0};
+      visit_contact(batches_, c.model, c.slot, [&](auto& data) {
+        update_contact(data, k, c.local, sink);
+        c.stiff = contact_stiffness(data);
+      });
+      const ContactResult& r = c.local;
+      c.force = -r.Fn * c.n + r.Fss * c.s + r.Fst * c.t;
+      c.moment = r.Mt * c.n + r.Mbs * c.s + r.Mbt * c.t;
+      for (std::size_t e = first_event; e < events.size(); ++e) {
+        Event& ev = events[e];
+        ev.step = step_;
+        ev.time = time_;
+        ev.normal = c.n;
+        ev.position = c.xc + ev.position.y() * c.s + ev.position.z() * c.t;
+        if (ev.gap == 0)
+          ev.gap = c.gap;
+      }
+    }
+  }
+
+  // Events in a fixed order: by contact, then by the order a contact raised them.
+  const std::size_t before = pending_events_.size();
+  for (auto& buf : thread_events_)
+    pending_events_.insert(pending_events_.end(), buf.begin(), buf.end());
+  std::sort(pending_events_.begin() + static_cast<std::ptrdiff_t>(before), pending_events_.end(),
+            [](const Event& x, const Event& y) {
+              return x.contact != y.contact ? x.contact < y.contact : x.seq < y.seq;
+            });
+
+  // Sum contact forces into balls, each ball over its contacts in contact order.
+  const std::size_t n = balls.size();
+  double dt_min = std::numeric_limits<double>::infinity();
+#pragma omp parallel for schedule(static) reduction(min : dt_min)
+  for (std::size_t i = 0; i < n; ++i) {
+    Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+    double k_tran = 0, k_rot = 0;
+    const Vec3& xi = balls.pos[i];
+    for (std::int32_t a = adj_start_[i]; a < adj_start_[i + 1]; ++a) {
+      const std::int32_t item = adj_items_[static_cast<std::size_t>(a)];
+      const Contact& c = contacts_[static_cast<std::size_t>(item >> 1)];
+      const double side = (item & 1) ? 1.0 : -1.0; // force acts on end2, reaction on end1
+      const Vec3 f = side * c.force;
+      const Vec3 arm = c.xc - xi;
+      F += f;
+      M += side * c.moment + arm.cross(f);
+      k_tran += c.stiff.k_tran;
+      k_rot += c.stiff.k_shear * arm.squaredNorm() + c.stiff.k_rot;
+    }
+    balls.force[i] = F;
+    balls.moment[i] = M;
+    if (k_tran > 0)
+      dt_min = std::min(dt_min, std::sqrt(balls.mass[i] / k_tran));
+    if (k_rot > 0)
+      dt_min = std::min(dt_min, std::sqrt(balls.inertia[i] / k_rot));
+  }
+  dt_stiffness_ = dt_min;
+
+  for (Wall& w : walls) {
+    w.force.setZero();
+    w.moment.setZero();
+  }
+  for (const Contact& c : contacts_) {
+    if (c.kind != ContactKind::BallFacet)
+      continue;
+    Wall& w = walls[static_cast<std::size_t>(c.end2)];
+    w.force += c.force;
+    w.moment += c.moment + (c.xc - w.center).cross(c.force);
+  }
+
+  if (blowup != none) {
+    const Contact& c = contacts_[blowup];
+    std::ostringstream msg;
+    msg << "physical blow-up at step " << step_ << " (t = " << time_
+        << " s): overlap beyond a radius at the contact between ball id "
+        << balls.id[static_cast<std::size_t>(c.end1)]
+        << (c.kind == ContactKind::BallBall ? " and ball id " : " and wall ")
+        << (c.kind == ContactKind::BallBall
+                ? std::to_string(balls.id[static_cast<std::size_t>(c.end2)])
+                : walls[static_cast<std::size_t>(c.end2)].name)
+        << " (gap " << c.gap << " m); reduce the time step or the loading rate";
+    throw PhysicsError(msg.str());
+  }
+}
+
+double Model::estimate_timestep() const {
+  if (settings.timestep > 0)
+    return settings.timestep;
+  double dt = settings.timestep_safety * dt_stiffness_;
+  // Nothing may move more than a quarter of the margin in one step, so that contacts exist
+  // before the pieces touch.
+  if (max_speed_ > 0)
+    dt = std::min(dt, 0.25 * margin_ / max_speed_);
+  const double g = settings.gravity.norm();
+  if (g > 0)
+    dt = std::min(dt, std::sqrt(0.25 * margin_ / g));
+  for (const Wall& w : walls) {
+    const double v = w.max_vertex_speed();
+    if (v > 0)
+      dt = std::min(dt, 0.25 * margin_ / v);
+  }
+  if (!std::isfinite(dt) || dt <= 0)
+    dt = 1e-3; // nothing constrains the step: no contacts, no motion, no gravity
+  return dt;
+}
+
+void Model::law_of_motion(double dt) {
+  const int dim = settings.dim;
+  const double alpha = settings.local_damping;
+  const Vec3 gvec = settings.gravity;
+  const int ntran = dim == 2 ? 2 : 3;
+  // acc: 0 body work, 1 gravity work, 2 boundary (constraint) work, 3 local damping, 4 max |v|
+  // and 5 max displacement are handled with separate reductions below.
+  double vmax = 0, dmax = 0;
+  bool bad = false;
+  const auto sums = block_sum<4>(balls.size(), [&](std::size_t i, std::array<double, 4>& acc) {
+    const double m = balls.mass[i];
+    const std::uint8_t fix = balls.fixity[i];
+    const Vec3 Fg = m * gvec;
+    const Vec3 Fbody = Fg + balls.applied_force[i];
+    const Vec3 F = balls.force[i] + Fbody;
+    Vec3& v = balls.vel[i];
+    for (int d = 0; d < ntran; ++d) {
+      const double v0 = v[d];
+      double v1 = v0;
+      if (fix & dof_bit(d)) {
+        acc[2] -= F[d] * v0 * dt; // the constraint force -F holds the velocity
+      } else {
+        const double Fd = -alpha * std::abs(F[d]) * sign(v0);
+        v1 = v0 + (F[d] + Fd) / m * dt;
+        acc[3] -= Fd * 0.5 * (v0 + v1) * dt;
+      }
+      v[d] = v1;
+      acc[0] += Fbody[d] * 0.5 * (v0 + v1) * dt;
+      acc[1] += Fg[d] * 0.5 * (v0 + v1) * dt;
+    }
+    const double I = balls.inertia[i];
+    const Vec3 M = balls.moment[i] + balls.applied_moment[i];
+    Vec3& w = balls.spin[i];
+    for (int d = (dim == 2 ? 2 : 0); d < 3; ++d) {
+      const double w0 = w[d];
+      double w1 = w0;
+      if (fix & dof_bit(3 + d)) {
+        acc[2] -= M[d] * w0 * dt;
+      } else {
+        const double Md = -alpha * std::abs(M[d]) * sign(w0);
+        w1 = w0 + (M[d] + Md) / I * dt;
+        acc[3] -= Md * 0.5 * (w0 + w1) * dt;
+      }
+      w[d] = w1;
+      acc[0] += balls.applied_moment[i][d] * 0.5 * (w0 + w1) * dt;
+    }
+    const Vec3 dx = v * dt;
+    balls.pos[i] += dx;
+    balls.disp[i] += dx;
+  });
+  ledger_.body_work += sums[0];
+  ledger_.gravity_work += sums[1];
+  ledger_.boundary_work += sums[2];
+  ledger_.local_damping += sums[3];
+
+  const std::size_t n = balls.size();
+#pragma omp parallel for schedule(static) reduction(max : vmax, dmax) reduction(|| : bad)
+  for (std::size_t i = 0; i < n; ++i) {
+    vmax = std::max(vmax, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
+    dmax = std::max(dmax, balls.disp[i].norm());
+    bad = bad || !balls.pos[i].allFinite() || !balls.vel[i].allFinite();
+  }
+  max_speed_ = vmax;
+  max_ball_disp_ = dmax;
+  if (bad) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (!balls.pos[i].allFinite() || !balls.vel[i].allFinite()) {
+        std::ostringstream msg;
+        msg << "physical blow-up at step " << step_ << " (t = " << time_ << " s): ball id "
+            << balls.id[i] << " has a non-finite position or velocity; reduce the time step";
+        throw PhysicsError(msg.str());
+      }
+  }
+}
+
+void Model::cycle(std::int64_t count) {
+  if (!initialized_)
+    initialize();
+  for (std::int64_t k = 0; k < count; ++k) {
+    const double dt = estimate_timestep();
+    dt_ = dt;
+    law_of_motion(dt);
+    double wall_work = 0;
+    for (Wall& w : walls) {
+      // Energy a moving wall puts in: the force on the balls (-force) times the wall motion.
+      wall_work -= (w.force.dot(w.velocity) + w.moment.dot(w.spin)) * dt;
+      wall_disp_ += w.max_vertex_speed() * dt;
+      w.move(dt);
+    }
+    ledger_.boundary_work += wall_work;
+    time_ += dt;
+    ++step_;
+    if (needs_detection())
+      detect();
+    force_displacement(dt);
+  }
+}
+
+EnergyLedger Model::energy() const {
+  EnergyLedger e = ledger_;
+  const auto kin = block_sum<2>(balls.size(), [&](std::size_t i, std::array<double, 2>& acc) {
+    acc[0] += 0.5 * balls.mass[i] * balls.vel[i].squaredNorm();
+    acc[1] += 0.5 * balls.inertia[i] * balls.spin[i].squaredNorm();
+  });
+  e.kinetic_translational = kin[0];
+  e.kinetic_rotational = kin[1];
+  const auto con = block_sum<5>(contacts_.size(), [&](std::size_t ci, std::array<double, 5>& acc) {
+    const Contact& c = contacts_[ci];
+    visit_contact(batches_, c.model, c.slot, [&](const auto& data) {
+      const ContactEnergy ce = contact_energy(data);
+      acc[0] += ce.strain;
+      acc[1] += ce.bond_strain;
+      acc[2] += ce.slip;
+      acc[3] += ce.dashpot;
+      acc[4] += ce.plastic;
+    });
+  });
+  e.strain = con[0];
+  e.bond_strain = con[1];
+  e.slip = con[2] + retired_.slip;
+  e.dashpot = con[3] + retired_.dashpot;
+  e.plastic = con[4] + retired_.plastic;
+  return e;
+}
+
+double Model::mean_unbalanced_force_ratio() const {
+  const int ntran = settings.dim == 2 ? 2 : 3;
+  const auto ub = block_sum<1>(balls.size(), [&](std::size_t i, std::array<double, 1>& acc) {
+    const Vec3 F = balls.force[i] + balls.mass[i] * settings.gravity + balls.applied_force[i];
+    double s = 0;
+    for (int d = 0; d < ntran; ++d)
+      if (!(balls.fixity[i] & dof_bit(d)))
+        s += F[d] * F[d];
+    acc[0] += std::sqrt(s);
+  });
+  const auto cf = block_sum<2>(contacts_.size(), [&](std::size_t ci, std::array<double, 2>& acc) {
+    const double f = contacts_[ci].force.norm();
+    if (f > 0) {
+      acc[0] += f;
+      acc[1] += 1;
+    }
+  });
+  const double mean_ub = balls.size() ? ub[0] / static_cast<double>(balls.size()) : 0.0;
+  const double mean_cf = cf[1] > 0 ? cf[0] / cf[1] : 0.0;
+  if (mean_cf <= 0)
+    return mean_ub > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  return mean_ub / mean_cf;
+}
+
+void Model::drain_events(std::vector<Event>& out) {
+  out.insert(out.end(), pending_events_.begin(), pending_events_.end());
+  pending_events_.clear();
+}
+
+std::size_t Model::active_contact_count() const {
+  std::size_t count = 0;
+  for (const Contact& c : contacts_)
+    if (c.local.Fn != 0 || c.local.Fss != 0 || c.local.Fst != 0 || c.local.Mt != 0 ||
+        c.local.Mbs != 0 || c.local.Mbt != 0)
+      ++count;
+  return count;
+}
+
+} // namespace rocklab

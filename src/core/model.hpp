@@ -1,0 +1,107 @@
+// The DEM model: bodies, contacts, the cycle (time step, law of motion, detection,
+// force-displacement), events and the energy ledger.
+#pragma once
+
+#include "contact/registry.hpp"
+#include "core/balls.hpp"
+#include "core/contact.hpp"
+#include "core/energy.hpp"
+#include "core/events.hpp"
+#include "core/walls.hpp"
+
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace rocklab {
+
+/// A physical blow-up (NaN, overlap beyond a radius): the run cannot continue.
+struct PhysicsError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct ModelSettings {
+  int dim = 3;                  ///< 2 (unit-thickness disks in xy) or 3
+  Vec3 gravity = Vec3::Zero();  ///< [m/s^2]
+  double local_damping = 0.7;   ///< local damping factor alpha [-], [0, 1)
+  double timestep = 0;          ///< > 0: fixed time step [s]; 0: automatic
+  double timestep_safety = 0.8; ///< factor on the automatic estimate [-], (0, 1]
+  double margin = 0;            ///< proximity margin [m]; 0: 0.1 x mean radius
+};
+
+/// Which model a new contact gets. The first matching rule wins.
+struct ModelRule {
+  bool ball_facet = false; ///< false: ball-ball rule; true: ball-facet rule
+  int group1 = -1;         ///< group of one ball (-1: any)
+  int group2 = -1;         ///< group of the other ball (-1: any); unused for ball-facet
+  int wall = -1;           ///< wall index for ball-facet rules (-1: any)
+  ModelProps props;
+};
+
+class Model {
+public:
+  ModelSettings settings;
+  Balls balls;
+  std::vector<Wall> walls;
+  std::vector<std::string> group_names;
+  std::vector<ModelRule> rules;
+
+  /// Index of a group name, added if new.
+  int group_index(const std::string& name);
+
+  /// Detect contacts and compute the initial forces; call once after set-up.
+  void initialize();
+  /// Run n cycles.
+  void cycle(std::int64_t n = 1);
+
+  double time() const { return time_; }
+  std::int64_t step() const { return step_; }
+  double timestep() const { return dt_; }
+  double margin() const { return margin_; }
+  const std::vector<Contact>& contacts() const { return contacts_; }
+  const ModelBatches& batches() const { return batches_; }
+
+  /// Current energies (stored partitions summed over contacts, accumulated ones from the ledger).
+  EnergyLedger energy() const;
+  /// Mean unbalanced force over balls divided by the mean contact force magnitude.
+  double mean_unbalanced_force_ratio() const;
+  /// Append the events buffered since the last drain (in a fixed order) to out and clear them.
+  void drain_events(std::vector<Event>& out);
+  /// Number of contacts whose model reports them active (carrying load).
+  std::size_t active_contact_count() const;
+
+private:
+  void detect();
+  void force_displacement(double dt_increment);
+  void law_of_motion(double dt);
+  double estimate_timestep() const;
+  bool needs_detection() const;
+
+  std::vector<Contact> contacts_;
+  ModelBatches batches_;
+  // Scratch storage reused between detections (no allocation in the steady cycle).
+  std::vector<Contact> new_contacts_;
+  ModelBatches new_batches_;
+  std::vector<std::uint64_t> candidate_keys_;
+  std::vector<std::vector<std::uint64_t>> thread_keys_;
+  std::vector<std::int32_t> cell_start_, cell_items_;
+  std::vector<std::int32_t> adj_start_, adj_items_; // ball -> contacts (index*2 + side)
+  std::vector<EventBuffer> thread_events_;
+  std::vector<Event> pending_events_;
+
+  double time_ = 0;
+  double dt_ = 0;
+  double margin_ = 0;
+  double max_ball_disp_ = 0;
+  double wall_disp_ = 0;
+  double max_speed_ = 0;
+  double dt_stiffness_ = 0; ///< stiffness-limited step from the last force update [s]
+  std::int64_t step_ = 0;
+  bool initialized_ = false;
+  EnergyLedger ledger_;
+  ContactEnergy retired_; ///< dissipation of deleted contacts
+  std::size_t blowup_contact_ = 0;
+};
+
+} // namespace rocklab

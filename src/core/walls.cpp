@@ -1,0 +1,81 @@
+#include "core/walls.hpp"
+
+#include <algorithm>
+
+namespace rocklab {
+
+void Wall::update_bounds() {
+  lo = Vec3::Constant(1e300);
+  hi = Vec3::Constant(-1e300);
+  for (const Facet& f : facets)
+    for (int k = 0; k < f.nv; ++k) {
+      lo = lo.cwiseMin(f.v[k]);
+      hi = hi.cwiseMax(f.v[k]);
+    }
+}
+
+void Wall::move(double dt) {
+  const Vec3 dx = velocity * dt;
+  const Vec3 phi = spin * dt;
+  const bool rotates = phi.squaredNorm() > 0;
+  for (Facet& f : facets)
+    for (int k = 0; k < f.nv; ++k)
+      f.v[k] = rotates ? (center + rotate_by(f.v[k] - center, phi) + dx) : Vec3(f.v[k] + dx);
+  center += dx;
+  update_bounds();
+}
+
+double Wall::max_vertex_speed() const {
+  double vmax = 0;
+  const double w = spin.norm();
+  for (const Facet& f : facets)
+    for (int k = 0; k < f.nv; ++k)
+      vmax = std::max(vmax, velocity.norm() + w * (f.v[k] - center).norm());
+  return vmax;
+}
+
+namespace {
+Vec3 closest_on_segment(const Vec3& a, const Vec3& b, const Vec3& p) {
+  const Vec3 ab = b - a;
+  const double len2 = ab.squaredNorm();
+  if (len2 <= 0)
+    return a;
+  const double u = std::clamp((p - a).dot(ab) / len2, 0.0, 1.0);
+  return a + u * ab;
+}
+
+// Closest point on triangle abc to p, by Voronoi-region classification.
+Vec3 closest_on_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& p) {
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0)
+    return a;
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3)
+    return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0)
+    return a + (d1 / (d1 - d3)) * ab;
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6)
+    return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0)
+    return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+} // namespace
+
+Vec3 closest_point_on_facet(const Facet& f, const Vec3& p) {
+  if (f.nv == 2)
+    return closest_on_segment(f.v[0], f.v[1], p);
+  return closest_on_triangle(f.v[0], f.v[1], f.v[2], p);
+}
+
+} // namespace rocklab

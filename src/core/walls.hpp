@@ -1,0 +1,39 @@
+// Walls: rigid collections of facets (segments in 2D, triangles in 3D) with prescribed motion.
+#pragma once
+
+#include "core/types.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace rocklab {
+
+/// A planar piece of a wall: a segment (nv = 2) in 2D or a triangle (nv = 3) in 3D.
+struct Facet {
+  std::array<Vec3, 3> v{Vec3::Zero(), Vec3::Zero(), Vec3::Zero()}; ///< vertices [m]
+  int nv = 3;
+};
+
+/// A wall moves rigidly with a prescribed velocity and spin about its centre of rotation.
+struct Wall {
+  std::string name;
+  std::vector<Facet> facets;
+  Vec3 center = Vec3::Zero();                ///< centre of rotation [m]
+  Vec3 velocity = Vec3::Zero();              ///< translational velocity [m/s]
+  Vec3 spin = Vec3::Zero();                  ///< rotational velocity about center [rad/s]
+  Vec3 force = Vec3::Zero();                 ///< resultant contact force acting on the wall [N]
+  Vec3 moment = Vec3::Zero();                ///< resultant contact moment about center [N m]
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero(); ///< bounding box [m]
+
+  void update_bounds();
+  /// Advance the wall by one step of length dt (translation, then rotation about center).
+  void move(double dt);
+  /// Largest distance a vertex moves in one step of length dt [m].
+  double max_vertex_speed() const;
+};
+
+/// Closest point of a facet to p.
+Vec3 closest_point_on_facet(const Facet& f, const Vec3& p);
+
+} // namespace rocklab

@@ -1,0 +1,235 @@
+#include "io/json_input.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace rocklab {
+
+bool Range::contains(double v) const {
+  if (std::isnan(v))
+    return false;
+  const bool lo_ok = lo_open ? v > lo : v >= lo;
+  const bool hi_ok = hi_open ? v < hi : v <= hi;
+  return lo_ok && hi_ok;
+}
+
+namespace {
+std::string fmt(double v) {
+  if (std::isinf(v))
+    return v > 0 ? "+inf" : "-inf";
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+} // namespace
+
+std::string Range::str() const {
+  return std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + (hi_open ? ")" : "]");
+}
+
+std::string describe(const nlohmann::json& v) {
+  std::string s = v.dump();
+  if (s.size() > 60)
+    s = s.substr(0, 57) + "...";
+  return std::string(v.type_name()) + " " + s;
+}
+
+nlohmann::json read_json_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in)
+    throw InputError(path + ": cannot open file (missing or unreadable)");
+  try {
+    return nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::parse_error& e) {
+    // e.byte gives the position; report line and column for a person.
+    std::ifstream again(path);
+    std::string text((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    throw InputError(path + ":" + std::to_string(line) + ":" + std::to_string(col) +
+                     ": malformed JSON: " + e.what());
+  }
+}
+
+JsonObject::JsonObject(const nlohmann::json& j, std::string file, std::string path)
+    : j_(j), file_(std::move(file)), path_(std::move(path)) {
+  if (!j_.is_object())
+    throw InputError(file_ + ": key '" + (path_.empty() ? "<top level>" : path_) +
+                     "': expected an object, got " + describe(j_));
+}
+
+std::string JsonObject::key_path(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+void JsonObject::fail(const std::string& key, const std::string& what) const {
+  throw InputError(file_ + ": key '" + key_path(key) + "': " + what);
+}
+
+bool JsonObject::has(const std::string& key) const {
+  return j_.contains(key);
+}
+
+const nlohmann::json& JsonObject::raw(const std::string& key) {
+  used_.insert(key);
+  if (!j_.contains(key))
+    throw InputError(file_ + ": missing required key '" + key_path(key) + "'");
+  return j_.at(key);
+}
+
+double JsonObject::number(const std::string& key, Range r, std::optional<double> def,
+                          const char* unit) {
+  used_.insert(key);
+  if (!j_.contains(key)) {
+    if (def)
+      return *def;
+    throw InputError(file_ + ": missing required key '" + key_path(key) + "' (a number in " +
+                     r.str() + (unit[0] ? std::string(" ") + unit : "") + ")");
+  }
+  const auto& v = j_.at(key);
+  if (!v.is_number())
+    fail(key, "expected a number in " + r.str() + ", got " + describe(v));
+  const double x = v.get<double>();
+  if (!r.contains(x))
+    fail(key, "value " + v.dump() + " is out of range " + r.str() +
+                  (unit[0] ? std::string(" ") + unit : ""));
+  return x;
+}
+
+std::int64_t JsonObject::integer(const std::string& key, std::int64_t lo, std::int64_t hi,
+                                 std::optional<std::int64_t> def) {
+  used_.insert(key);
+  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  if (!j_.contains(key)) {
+    if (def)
+      return *def;
+    throw InputError(file_ + ": missing required key '" + key_path(key) + "' (an integer in " +
+                     range + ")");
+  }
+  const auto& v = j_.at(key);
+  if (!v.is_number_integer())
+    fail(key, "expected an integer in " + range + ", got " + describe(v));
+  const std::int64_t x = v.get<std::int64_t>();
+  if (x < lo || x > hi)
+    fail(key, "value " + v.dump() + " is out of range " + range);
+  return x;
+}
+
+bool JsonObject::boolean(const std::string& key, std::optional<bool> def) {
+  used_.insert(key);
+  if (!j_.contains(key)) {
+    if (def)
+      return *def;
+    throw InputError(file_ + ": missing required key '" + key_path(key) + "' (true or false)");
+  }
+  const auto& v = j_.at(key);
+  if (!v.is_boolean())
+    fail(key, "expected true or false, got " + describe(v));
+  return v.get<bool>();
+}
+
+std::string JsonObject::string(const std::string& key, std::optional<std::string> def) {
+  used_.insert(key);
+  if (!j_.contains(key)) {
+    if (def)
+      return *def;
+    throw InputError(file_ + ": missing required key '" + key_path(key) + "' (a string)");
+  }
+  const auto& v = j_.at(key);
+  if (!v.is_string())
+    fail(key, "expected a string, got " + describe(v));
+  return v.get<std::string>();
+}
+
+std::string JsonObject::choice(const std::string& key, std::initializer_list<const char*> allowed,
+                               std::optional<std::string> def) {
+  std::string list;
+  for (const char* a : allowed)
+    list += (list.empty() ? "" : ", ") + std::string("\"") + a + "\"";
+  if (!j_.contains(key) && !def) {
+    used_.insert(key);
+    throw InputError(file_ + ": missing required key '" + key_path(key) + "' (one of " + list +
+                     ")");
+  }
+  const std::string v = string(key, def);
+  for (const char* a : allowed)
+    if (v == a)
+      return v;
+  fail(key, "value \"" + v + "\" is not allowed (one of " + list + ")");
+}
+
+Vec3 json_vec(const nlohmann::json& v, int dim, const std::string& file, const std::string& path) {
+  const std::string what = dim == 2 ? "2 numbers [x, y]" : "3 numbers [x, y, z]";
+  if (!v.is_array() || (v.size() != static_cast<std::size_t>(dim) && !(dim == 2 && v.size() == 3)))
+    throw InputError(file + ": key '" + path + "': expected an array of " + what + ", got " +
+                     describe(v));
+  Vec3 out = Vec3::Zero();
+  for (std::size_t k = 0; k < v.size(); ++k) {
+    if (!v[k].is_number())
+      throw InputError(file + ": key '" + path + "[" + std::to_string(k) +
+                       "]': expected a number, got " + describe(v[k]));
+    out[static_cast<int>(k)] = v[k].get<double>();
+  }
+  if (dim == 2 && out.z() != 0)
+    throw InputError(file + ": key '" + path + "': value " + v.dump() +
+                     " has a non-zero z component; 2D models live in the xy plane");
+  return out;
+}
+
+Vec3 JsonObject::vec(const std::string& key, int dim, std::optional<Vec3> def, Range r) {
+  used_.insert(key);
+  if (!j_.contains(key)) {
+    if (def)
+      return *def;
+    throw InputError(file_ + ": missing required key '" + key_path(key) + "'");
+  }
+  const Vec3 v = json_vec(j_.at(key), dim, file_, key_path(key));
+  for (int k = 0; k < 3; ++k)
+    if (!(dim == 2 && k == 2) && !r.contains(v[k]))
+      fail(key,
+           "component " + std::to_string(k) + " = " + fmt(v[k]) + " is out of range " + r.str());
+  return v;
+}
+
+JsonObject JsonObject::object(const std::string& key) {
+  return JsonObject(raw(key), file_, key_path(key));
+}
+
+std::vector<std::pair<const nlohmann::json*, std::string>> JsonObject::array(const std::string& key,
+                                                                             bool required) {
+  used_.insert(key);
+  std::vector<std::pair<const nlohmann::json*, std::string>> out;
+  if (!j_.contains(key)) {
+    if (required)
+      throw InputError(file_ + ": missing required key '" + key_path(key) + "' (an array)");
+    return out;
+  }
+  const auto& v = j_.at(key);
+  if (!v.is_array())
+    fail(key, "expected an array, got " + describe(v));
+  for (std::size_t i = 0; i < v.size(); ++i)
+    out.emplace_back(&v[i], key_path(key) + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+void JsonObject::finish() const {
+  for (auto it = j_.begin(); it != j_.end(); ++it) {
+    if (used_.count(it.key()))
+      continue;
+    std::string allowed;
+    for (const auto& u : used_)
+      allowed += (allowed.empty() ? "" : ", ") + u;
+    throw InputError(file_ + ": unknown key '" + key_path(it.key()) +
+                     "' (allowed here: " + allowed + ")");
+  }
+}
+
+} // namespace rocklab

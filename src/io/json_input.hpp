@@ -1,0 +1,83 @@
+// Validated reading of JSON input files. Every error names the file, the key (as a path such as
+// `balls[3].radius`), the offending value and the allowed range, and is thrown as InputError.
+#pragma once
+
+#include "core/types.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <initializer_list>
+#include <limits>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace rocklab {
+
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// An interval of allowed values; open or closed at each end.
+struct Range {
+  double lo = -std::numeric_limits<double>::infinity();
+  double hi = std::numeric_limits<double>::infinity();
+  bool lo_open = true, hi_open = true;
+  bool contains(double v) const;
+  std::string str() const;
+
+  static Range any() { return {}; }
+  static Range positive() { return {0, std::numeric_limits<double>::infinity(), true, true}; }
+  static Range non_negative() { return {0, std::numeric_limits<double>::infinity(), false, true}; }
+  static Range closed(double a, double b) { return {a, b, false, false}; }
+  static Range half_open(double a, double b) { return {a, b, false, true}; }
+};
+
+/// Parse a JSON file; syntax errors name the file, line and column.
+nlohmann::json read_json_file(const std::string& path);
+
+/// A JSON object being read: tracks the keys used so unknown keys can be reported.
+class JsonObject {
+public:
+  JsonObject(const nlohmann::json& j, std::string file, std::string path);
+
+  bool has(const std::string& key) const;
+  const nlohmann::json& raw(const std::string& key);
+  std::string key_path(const std::string& key) const;
+
+  double number(const std::string& key, Range r, std::optional<double> def = std::nullopt,
+                const char* unit = "");
+  std::int64_t integer(const std::string& key, std::int64_t lo, std::int64_t hi,
+                       std::optional<std::int64_t> def = std::nullopt);
+  bool boolean(const std::string& key, std::optional<bool> def = std::nullopt);
+  std::string string(const std::string& key, std::optional<std::string> def = std::nullopt);
+  std::string choice(const std::string& key, std::initializer_list<const char*> allowed,
+                     std::optional<std::string> def = std::nullopt);
+  /// A vector of `dim` numbers (2D input may give 2 components; z is then 0).
+  Vec3 vec(const std::string& key, int dim, std::optional<Vec3> def = std::nullopt,
+           Range r = Range::any());
+  JsonObject object(const std::string& key);
+  /// Array elements, with their paths, for the caller to read.
+  std::vector<std::pair<const nlohmann::json*, std::string>> array(const std::string& key,
+                                                                   bool required = true);
+  /// Fail on keys that were never read.
+  void finish() const;
+
+  const std::string& file() const { return file_; }
+  const std::string& path() const { return path_; }
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
+private:
+  const nlohmann::json& j_;
+  std::string file_, path_;
+  std::set<std::string> used_;
+};
+
+/// Read a vector from a bare JSON value (for array elements).
+Vec3 json_vec(const nlohmann::json& v, int dim, const std::string& file, const std::string& path);
+
+std::string describe(const nlohmann::json& v);
+
+} // namespace rocklab

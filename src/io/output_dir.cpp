@@ -1,0 +1,58 @@
+#include "io/output_dir.hpp"
+
+#include <fstream>
+#include <stdexcept>
+#include <system_error>
+#include <unistd.h>
+
+namespace rocklab {
+
+namespace fs = std::filesystem;
+
+OutputDir::OutputDir(const std::string& path) : dir_(path) {
+  std::error_code ec;
+  if (fs::exists(dir_, ec)) {
+    if (!fs::is_directory(dir_, ec))
+      throw std::runtime_error(path + ": output path exists and is not a directory");
+  } else {
+    fs::create_directories(dir_, ec);
+    if (ec)
+      throw std::runtime_error(path + ": cannot create output directory: " + ec.message());
+    created_dir_ = true;
+  }
+  staging_ = dir_ / (".partial-" + std::to_string(::getpid()));
+  fs::remove_all(staging_, ec);
+  fs::create_directories(staging_, ec);
+  if (ec)
+    throw std::runtime_error(staging_.string() + ": cannot create staging folder: " + ec.message());
+}
+
+OutputDir::~OutputDir() {
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+  if (!committed_ && created_dir_)
+    fs::remove_all(dir_, ec);
+}
+
+void OutputDir::commit() {
+  for (const auto& entry : fs::directory_iterator(staging_)) {
+    const fs::path dest = dir_ / entry.path().filename();
+    std::error_code ec;
+    if (fs::is_directory(dest, ec) && entry.is_directory())
+      fs::remove_all(dest, ec);
+    fs::rename(entry.path(), dest);
+  }
+  committed_ = true;
+}
+
+void write_text_file(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  if (!out)
+    throw std::runtime_error(p.string() + ": cannot open for writing");
+  out << text;
+  out.close();
+  if (!out)
+    throw std::runtime_error(p.string() + ": write failed (disk full?)");
+}
+
+} // namespace rocklab

@@ -1,0 +1,32 @@
+// An output directory that is either complete or untouched: files are written into a staging
+// folder inside it and moved in place only when the run finishes.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace rocklab {
+
+class OutputDir {
+public:
+  explicit OutputDir(const std::string& path);
+  ~OutputDir();
+  OutputDir(const OutputDir&) = delete;
+  OutputDir& operator=(const OutputDir&) = delete;
+
+  /// Where to write a file now (inside the staging folder).
+  std::filesystem::path staged(const std::string& name) const { return staging_ / name; }
+  /// Move every staged file into the directory; after this the destructor keeps everything.
+  void commit();
+  const std::filesystem::path& path() const { return dir_; }
+
+private:
+  std::filesystem::path dir_, staging_;
+  bool created_dir_ = false;
+  bool committed_ = false;
+};
+
+/// Write text to a file; throws std::runtime_error naming the file on failure.
+void write_text_file(const std::filesystem::path& p, const std::string& text);
+
+} // namespace rocklab

@@ -1,0 +1,134 @@
+#include "io/results.hpp"
+
+#include <charconv>
+#include <cmath>
+
+namespace rocklab {
+
+namespace {
+nlohmann::json vec_json(const Vec3& v, int dim) {
+  if (dim == 2)
+    return nlohmann::json::array({v.x(), v.y()});
+  return nlohmann::json::array({v.x(), v.y(), v.z()});
+}
+} // namespace
+
+std::string format_double(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+nlohmann::json energy_json(const EnergyLedger& e) {
+  return {{"kinetic", e.kinetic()},
+          {"kinetic_translational", e.kinetic_translational},
+          {"kinetic_rotational", e.kinetic_rotational},
+          {"strain", e.strain},
+          {"bond_strain", e.bond_strain},
+          {"body_work", e.body_work},
+          {"gravity_work", e.gravity_work},
+          {"boundary_work", e.boundary_work},
+          {"local_damping", e.local_damping},
+          {"slip", e.slip},
+          {"dashpot", e.dashpot},
+          {"plastic", e.plastic},
+          {"initial_total", e.initial_total},
+          {"balance_error", e.balance_error()}};
+}
+
+nlohmann::json results_json(const Model& m, const EventCounts& counts,
+                            const std::string& scene_file) {
+  const int dim = m.settings.dim;
+  nlohmann::json out;
+  out["rocklab_version"] = ROCKLAB_VERSION;
+  out["units"] = "SI: m, kg, s, N, N m, Pa, J, rad";
+  out["scene"] = scene_file;
+  out["dimension"] = dim;
+  out["step"] = m.step();
+  out["time_s"] = m.time();
+  out["timestep_s"] = m.timestep();
+  out["energy_J"] = energy_json(m.energy());
+  out["events"] = {{"contact_created", counts.created},
+                   {"contact_deleted", counts.deleted},
+                   {"slip_change", counts.slip_change},
+                   {"bond_break", counts.bond_break}};
+  nlohmann::json balls = nlohmann::json::array();
+  const Balls& b = m.balls;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    nlohmann::json jb{{"id", b.id[i]},
+                      {"group", m.group_names[static_cast<std::size_t>(b.group[i])]},
+                      {"radius", b.radius[i]},
+                      {"mass", b.mass[i]},
+                      {"position", vec_json(b.pos[i], dim)},
+                      {"velocity", vec_json(b.vel[i], dim)},
+                      {"force", vec_json(b.force[i], dim)}};
+    if (dim == 2) {
+      jb["spin"] = b.spin[i].z();
+      jb["moment"] = b.moment[i].z();
+    } else {
+      jb["spin"] = vec_json(b.spin[i], dim);
+      jb["moment"] = vec_json(b.moment[i], dim);
+    }
+    balls.push_back(std::move(jb));
+  }
+  out["balls"] = std::move(balls);
+  nlohmann::json walls = nlohmann::json::array();
+  for (const Wall& w : m.walls) {
+    nlohmann::json jw{
+        {"name", w.name}, {"center", vec_json(w.center, dim)}, {"force", vec_json(w.force, dim)}};
+    if (dim == 2)
+      jw["moment"] = w.moment.z();
+    else
+      jw["moment"] = vec_json(w.moment, dim);
+    walls.push_back(std::move(jw));
+  }
+  out["walls"] = std::move(walls);
+  nlohmann::json contacts = nlohmann::json::array();
+  for (const Contact& c : m.contacts()) {
+    const bool bb = c.kind == ContactKind::BallBall;
+    nlohmann::json jc{
+        {"kind", bb ? "ball-ball" : "ball-facet"},
+        {"model", std::string(model_name(c.model))},
+        {"end1", b.id[static_cast<std::size_t>(c.end1)]},
+        {"end2", bb ? nlohmann::json(b.id[static_cast<std::size_t>(c.end2)])
+                    : nlohmann::json(m.walls[static_cast<std::size_t>(c.end2)].name)},
+        {"position", vec_json(c.xc, dim)},
+        {"normal", vec_json(c.n, dim)},
+        {"gap", c.gap},
+        {"force", vec_json(c.force, dim)},
+        {"moment", dim == 2 ? nlohmann::json(c.moment.z()) : vec_json(c.moment, dim)},
+        {"force_local", {{"Fn", c.local.Fn}, {"Fss", c.local.Fss}, {"Fst", c.local.Fst}}},
+        {"moment_local", {{"Mt", c.local.Mt}, {"Mbs", c.local.Mbs}, {"Mbt", c.local.Mbt}}}};
+    visit_contact(m.batches(), c.model, c.slot, [&](const auto& data) {
+      using T = std::decay_t<decltype(data)>;
+      if constexpr (std::is_same_v<T, LinearContact>) {
+        jc["state"] = {{"kn", data.p.kn},
+                       {"ks", data.p.ks},
+                       {"slip", data.s.slip},
+                       {"E_slip", data.s.E_slip},
+                       {"E_dashpot", data.s.E_dashpot}};
+      }
+    });
+    contacts.push_back(std::move(jc));
+  }
+  out["contacts"] = std::move(contacts);
+  return out;
+}
+
+std::string history_header(const std::vector<HistoryColumn>& cols) {
+  std::string s;
+  for (std::size_t k = 0; k < cols.size(); ++k)
+    s += (k ? "," : "") + cols[k].name;
+  return s + "\n";
+}
+
+std::string history_row(const Model& m, const std::vector<HistoryColumn>& cols,
+                        const EventCounts& counts) {
+  const EnergyLedger e = m.energy();
+  std::string s;
+  for (std::size_t k = 0; k < cols.size(); ++k)
+    s += (k ? "," : "") + format_double(history_value(m, cols[k], e, counts));
+  return s + "\n";
+}
+
+} // namespace rocklab

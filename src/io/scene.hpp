@@ -1,0 +1,65 @@
+// Scenes: hand-built models described in JSON (docs/scene-format.md). Units are SI.
+#pragma once
+
+#include "core/model.hpp"
+#include "io/json_input.hpp"
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rocklab {
+
+/// When a scene run stops.
+struct RunSpec {
+  std::int64_t cycles = 0;       ///< run exactly this many cycles (0: not used)
+  double time = 0;               ///< run until model time reaches this [s] (0: not used)
+  double ratio = 0;              ///< stop when the mean unbalanced-force ratio falls below [-]
+  std::int64_t max_cycles = 0;   ///< upper bound for time/ratio runs (0: none)
+  std::int64_t check_every = 10; ///< cycles between ratio checks
+};
+
+/// One history column: a quantity sampled every `every` cycles.
+struct HistoryColumn {
+  std::string name;
+  enum class Kind {
+    Step,
+    Time,
+    Timestep,
+    Energy,
+    Ball,
+    Wall,
+    Contacts,
+    ActiveContacts,
+    Ratio,
+    Events
+  };
+  Kind kind = Kind::Step;
+  std::string quantity;  ///< energy partition, ball/wall quantity or event type
+  std::size_t index = 0; ///< ball or wall index
+  int component = 0;     ///< 0..2 = x..z, 3 = magnitude
+};
+
+struct Scene {
+  std::string file;
+  std::string description;
+  std::unique_ptr<Model> model;
+  RunSpec run;
+  std::int64_t history_every = 0;
+  std::vector<HistoryColumn> history;
+};
+
+/// Load and validate a scene file. Throws InputError naming the file, key, value and range.
+Scene load_scene(const std::string& path);
+
+/// Event counts accumulated by a run, by type.
+struct EventCounts {
+  std::int64_t created = 0, deleted = 0, slip_change = 0, bond_break = 0;
+  void add(const std::vector<Event>& events);
+};
+
+/// Value of one history column in the current state.
+double history_value(const Model& m, const HistoryColumn& c, const EnergyLedger& e,
+                     const EventCounts& counts);
+
+} // namespace rocklab
