@@ -41,8 +41,9 @@ void update_linear_part(const LinearProps& p, LinearState& s, const ContactKinem
   }
   s.Fss = tss;
   s.Fst = tst;
-  // Slip energy: the part of the shear increment not taken up elastically does friction work.
-  if (p.ks > 0) {
+  // Slip energy: the part of the shear increment not taken up elastically does friction work
+  // (zero by definition while sticking; skipping it then avoids round-off residue).
+  if (slipping && p.ks > 0) {
     const double dk_ss = -(s.Fss - F0ss) / p.ks, dk_st = -(s.Fst - F0st) / p.ks;
     const double dmu_ss = k.d_dss - dk_ss, dmu_st = k.d_dst - dk_st;
     s.E_slip -= 0.5 * ((F0ss + s.Fss) * dmu_ss + (F0st + s.Fst) * dmu_st);
