@@ -32,15 +32,26 @@ void update_plane_axes(int dim, const Vec3& n_old, const Vec3& n_new, const Vec3
     t = Vec3::UnitZ().cross(n_new); // Eq. 4
     return;
   }
-  // Eq. 5: first rotation about the line common to the old and new planes...
-  const Vec3 s1 = s - s.cross(n_old.cross(n_new));
-  // ...then about the new normal by the mean spin of the two pieces.
-  const Vec3 w_tilde = (0.5 * (w1 + w2).dot(n_new)) * n_new;
-  Vec3 s2 = s1 - s1.cross(w_tilde * dt);
-  // Eq. 5 normalizes s2; projecting out n as well keeps the frame orthonormal to round-off
-  // over millions of steps (the increments are first order in dt).
-  s2 -= s2.dot(n_new) * n_new;
-  s = s2.normalized();
+  // Eq. 5 applies two small rotations to s in linearised form. We apply the same two rotations
+  // exactly (Rodrigues): the linearised form is not a rotation, so it would make the stored
+  // shear components depend on the arbitrary initial choice of s at second order per step,
+  // which breaks rotational invariance. The first rotation is about the line common to the old
+  // and new planes, by the angle between the normals...
+  const Vec3 axis = n_old.cross(n_new);
+  const double sin_a = axis.norm(), cos_a = n_old.dot(n_new);
+  if (sin_a > 0) {
+    const Vec3 k = axis / sin_a;
+    s = s * cos_a + k.cross(s) * sin_a + k * (k.dot(s) * (1 - cos_a));
+  }
+  // ...the second about the new normal by the mean spin of the two pieces times dt.
+  const double angle = 0.5 * (w1 + w2).dot(n_new) * dt;
+  if (angle != 0) {
+    const double c = std::cos(angle), sn = std::sin(angle);
+    s = s * c + n_new.cross(s) * sn + n_new * (n_new.dot(s) * (1 - c));
+  }
+  // Keep the frame orthonormal to round-off over millions of steps.
+  s -= s.dot(n_new) * n_new;
+  s.normalize();
   t = n_new.cross(s); // n = s x t
 }
 

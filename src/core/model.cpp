@@ -84,6 +84,10 @@ void Model::initialize() {
       sum += r;
     margin_ = balls.size() ? 0.1 * sum / static_cast<double>(balls.size()) : 0.0;
   }
+  // The speed cap of the automatic step needs the initial velocities before the first step.
+  max_speed_ = 0;
+  for (std::size_t i = 0; i < balls.size(); ++i)
+    max_speed_ = std::max(max_speed_, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
   detect();
   force_displacement(0.0);
   const EnergyLedger e = energy();
@@ -348,7 +352,8 @@ void Model::force_displacement(double dt) {
         v2 = wall.velocity;
         w2 = wall.spin;
       }
-      if (!c.initialized) {
+      const bool fresh = !c.initialized;
+      if (fresh) {
         if (dim == 2) {
           c.s = -Vec3::UnitZ();
           c.t = Vec3::UnitZ().cross(g.n);
@@ -360,11 +365,15 @@ void Model::force_displacement(double dt) {
       } else {
         update_plane_axes(dim, c.n, g.n, balls.spin[i1], w2, dt, c.s, c.t);
       }
+      // Blow-up: overlap beyond a radius. A facet contact measures an unsigned distance, so
+      // there the overlap reaching the radius shows as the normal flipping within one step.
+      const bool through = c.kind == ContactKind::BallFacet && !fresh && g.n.dot(c.n) < 0;
+      if (g.gap < -std::min(R1, c.kind == ContactKind::BallBall ? R2 : R1) || through ||
+          !std::isfinite(g.gap))
+        blowup = std::min(blowup, ci);
       c.xc = g.xc;
       c.n = g.n;
       c.gap = g.gap;
-      if (g.gap < -std::min(R1, c.kind == ContactKind::BallBall ? R2 : R1) || !std::isfinite(g.gap))
-        blowup = std::min(blowup, ci);
 
       ContactKinematics k;
       k.dt = dt;
@@ -456,7 +465,9 @@ void Model::force_displacement(double dt) {
         << (c.kind == ContactKind::BallBall
                 ? std::to_string(balls.id[static_cast<std::size_t>(c.end2)])
                 : walls[static_cast<std::size_t>(c.end2)].name)
-        << " (gap " << c.gap << " m); reduce the time step or the loading rate";
+        << " (gap " << c.gap
+        << " m, or the ball passed through the wall); reduce the time step, "
+           "the loading rate or raise the stiffness";
     throw PhysicsError(msg.str());
   }
 }
@@ -489,7 +500,7 @@ void Model::law_of_motion(double dt) {
   const int ntran = dim == 2 ? 2 : 3;
   // acc: 0 body work, 1 gravity work, 2 boundary (constraint) work, 3 local damping, 4 max |v|
   // and 5 max displacement are handled with separate reductions below.
-  double vmax = 0, dmax = 0;
+  double vmax = 0, dmax = 0, step_ratio = 0;
   bool bad = false;
   const auto sums = block_sum<4>(balls.size(), [&](std::size_t i, std::array<double, 4>& acc) {
     const double m = balls.mass[i];
@@ -538,14 +549,29 @@ void Model::law_of_motion(double dt) {
   ledger_.local_damping += sums[3];
 
   const std::size_t n = balls.size();
-#pragma omp parallel for schedule(static) reduction(max : vmax, dmax) reduction(|| : bad)
+#pragma omp parallel for schedule(static) reduction(max                                            \
+                                                    : vmax, dmax, step_ratio) reduction(||         \
+                                                                                        : bad)
   for (std::size_t i = 0; i < n; ++i) {
     vmax = std::max(vmax, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
+    step_ratio = std::max(step_ratio, balls.vel[i].norm() * dt / balls.radius[i]);
     dmax = std::max(dmax, balls.disp[i].norm());
     bad = bad || !balls.pos[i].allFinite() || !balls.vel[i].allFinite();
   }
   max_speed_ = vmax;
   max_ball_disp_ = dmax;
+  if (step_ratio > 1) {
+    // A ball that moves more than its radius in one step can pass through a contact unseen.
+    for (std::size_t i = 0; i < n; ++i)
+      if (balls.vel[i].norm() * dt > balls.radius[i]) {
+        std::ostringstream msg;
+        msg << "physical blow-up at step " << step_ << " (t = " << time_ << " s): ball id "
+            << balls.id[i] << " moved " << balls.vel[i].norm() * dt
+            << " m in one step, more than its radius " << balls.radius[i]
+            << " m; reduce the time step";
+        throw PhysicsError(msg.str());
+      }
+  }
   if (bad) {
     for (std::size_t i = 0; i < n; ++i)
       if (!balls.pos[i].allFinite() || !balls.vel[i].allFinite()) {

@@ -1,0 +1,188 @@
+// The command line: determinism, bad input, examples.
+#include "helpers.hpp"
+
+#include <filesystem>
+
+namespace fs = std::filesystem;
+using rocklab::test::binary;
+using rocklab::test::read_file;
+using rocklab::test::run_command;
+using rocklab::test::source_dir;
+
+namespace {
+fs::path scratch(const std::string& name) {
+  const fs::path p = fs::temp_directory_path() / ("rocklab-test-" + name);
+  fs::remove_all(p);
+  return p;
+}
+fs::path write_scene(const std::string& name, const std::string& text) {
+  const fs::path p = fs::temp_directory_path() / ("rocklab-scene-" + name + ".json");
+  std::ofstream(p) << text;
+  return p;
+}
+const char* kGoodScene = R"({
+  "dimension": 3,
+  "balls": [{"id": 1, "position": [0, 0, 0.0105], "radius": 0.01, "density": 2650}],
+  "walls": [{"name": "floor", "plane": {"point": [0, 0, 0], "normal": [0, 0, 1], "extent": 1}}],
+  "gravity": [0, 0, -9.81],
+  "contact_models": [{"between": "ball-facet", "model": "linear", "properties": {"kn": 1e4}}],
+  "run": {"cycles": 100}
+})";
+} // namespace
+
+TEST(Cli, DeterministicAcrossThreadsAndRepeats) {
+  const std::string scene = source_dir() + "/examples/settling_2k.json";
+  std::string out;
+  const fs::path a = scratch("det-1"), b = scratch("det-2"), c = scratch("det-2b");
+  ASSERT_EQ(run_command(binary() + " run " + scene + " -o " + a.string() + " --threads 1 -q", &out),
+            0)
+      << out;
+  ASSERT_EQ(run_command(binary() + " run " + scene + " -o " + b.string() + " --threads 2 -q", &out),
+            0)
+      << out;
+  ASSERT_EQ(run_command(binary() + " run " + scene + " -o " + c.string() + " --threads 2 -q", &out),
+            0)
+      << out;
+  const std::string ra = read_file(a / "results.json");
+  ASSERT_GT(ra.size(), 100000u);
+  EXPECT_EQ(ra, read_file(b / "results.json"));
+  EXPECT_EQ(ra, read_file(c / "results.json"));
+  EXPECT_EQ(read_file(a / "history.csv"), read_file(b / "history.csv"));
+  // The scene really is dynamic: many contacts were created and most balls carry load.
+  EXPECT_NE(ra.find("\"contact_created\""), std::string::npos);
+}
+
+TEST(Cli, MalformedJson) {
+  const fs::path scene = write_scene("malformed", "{\"dimension\": 3,, }");
+  const fs::path out = scratch("malformed");
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string(), &msg), 2);
+  EXPECT_NE(msg.find(scene.string() + ":1:"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("malformed JSON"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, UnknownKey) {
+  std::string text = kGoodScene;
+  text.replace(text.find("\"radius\""), 8, "\"raduis\"");
+  const fs::path scene = write_scene("unknown", text);
+  const fs::path out = scratch("unknown");
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string(), &msg), 2);
+  // A misspelt required key is reported as missing first; an extra key as unknown.
+  EXPECT_NE(msg.find("balls[0].radius"), std::string::npos) << msg;
+  text = kGoodScene;
+  text.replace(text.find("\"density\": 2650"), 15, "\"density\": 2650, \"colour\": 1");
+  const fs::path scene2 = write_scene("unknown2", text);
+  EXPECT_EQ(run_command(binary() + " run " + scene2.string() + " -o " + out.string(), &msg), 2);
+  EXPECT_NE(msg.find("unknown key 'balls[0].colour'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find(scene2.string()), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, NegativeRadius) {
+  std::string text = kGoodScene;
+  text.replace(text.find("\"radius\": 0.01"), 14, "\"radius\": -0.01");
+  const fs::path scene = write_scene("negative", text);
+  const fs::path out = scratch("negative");
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string(), &msg), 2);
+  EXPECT_NE(msg.find("key 'balls[0].radius': value -0.01 is out of range (0, +inf) m"),
+            std::string::npos)
+      << msg;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, WrongType) {
+  std::string text = kGoodScene;
+  text.replace(text.find("\"cycles\": 100"), 13, "\"cycles\": \"many\"");
+  const fs::path scene = write_scene("wrongtype", text);
+  const fs::path out = scratch("wrongtype");
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string(), &msg), 2);
+  EXPECT_NE(msg.find("key 'run.cycles': expected an integer"), std::string::npos) << msg;
+}
+
+TEST(Cli, MissingFile) {
+  const fs::path out = scratch("missing");
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " run /nonexistent/scene.json -o " + out.string(), &msg), 2);
+  EXPECT_NE(msg.find("/nonexistent/scene.json: cannot open file"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, ExistingOutputDirIsLeftUntouchedOnError) {
+  const fs::path out = scratch("existing");
+  fs::create_directories(out);
+  std::ofstream(out / "keep.txt") << "old";
+  std::string text = kGoodScene;
+  text.replace(text.find("\"radius\": 0.01"), 14, "\"radius\": -0.01");
+  const fs::path scene = write_scene("existing", text);
+  EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string()), 2);
+  EXPECT_EQ(read_file(out / "keep.txt"), "old");
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(out))
+    ++n;
+  EXPECT_EQ(n, 1u);
+}
+
+TEST(Cli, BlowUpStopsWithAMessage) {
+  // A ball fired into a very soft facet overlaps beyond its radius.
+  const std::string text = R"({
+    "dimension": 3,
+    "balls": [{"position": [0, 0, 0.011], "radius": 0.01, "density": 2650, "velocity": [0, 0, -50]}],
+    "walls": [{"name": "floor", "plane": {"point": [0, 0, 0], "normal": [0, 0, 1], "extent": 1}}],
+    "contact_models": [{"between": "ball-facet", "model": "linear", "properties": {"kn": 1}}],
+    "run": {"cycles": 100}})";
+  const fs::path scene = write_scene("blowup", text);
+  const fs::path out = scratch("blowup");
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string(), &msg), 3);
+  EXPECT_NE(msg.find("physical blow-up"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("overlap beyond a radius"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, TooLargeFixedStepStopsWithAMessage) {
+  // With a fixed step of 1 ms a ball at 50 m/s would jump through the floor unseen.
+  const std::string text = R"({
+    "dimension": 3, "timestep": 1e-3,
+    "balls": [{"position": [0, 0, 0.011], "radius": 0.01, "density": 2650, "velocity": [0, 0, -50]}],
+    "walls": [{"name": "floor", "plane": {"point": [0, 0, 0], "normal": [0, 0, 1], "extent": 1}}],
+    "contact_models": [{"between": "ball-facet", "model": "linear", "properties": {"kn": 1e4}}],
+    "run": {"cycles": 100}})";
+  const fs::path scene = write_scene("bigstep", text);
+  const fs::path out = scratch("bigstep");
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string(), &msg), 3);
+  EXPECT_NE(msg.find("more than its radius"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, HelpAndVersion) {
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " --version", &msg), 0);
+  EXPECT_NE(msg.find("rocklab"), std::string::npos);
+  EXPECT_EQ(run_command(binary() + " --help", &msg), 0);
+  EXPECT_NE(msg.find("run"), std::string::npos);
+  EXPECT_NE(msg.find("SI"), std::string::npos);
+}
+
+TEST(Cli, EveryExampleRuns) {
+  std::size_t count = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(source_dir() + "/examples")) {
+    if (entry.path().extension() != ".json")
+      continue;
+    const fs::path out = scratch("example-" + entry.path().stem().string());
+    std::string msg;
+    EXPECT_EQ(run_command(
+                  binary() + " run " + entry.path().string() + " -o " + out.string() + " -q", &msg),
+              0)
+        << entry.path() << "\n"
+        << msg;
+    EXPECT_TRUE(fs::exists(out / "results.json")) << entry.path();
+    EXPECT_TRUE(fs::exists(out / "history.csv")) << entry.path();
+    ++count;
+  }
+  EXPECT_GE(count, 5u);
+}
