@@ -55,9 +55,10 @@ Snapshot run_cluster(const Eigen::Matrix3d& R, const Vec3& shift) {
   m.initialize();
   m.cycle(1000);
   Snapshot s;
-  for (const Contact& c : m.contacts()) {
-    s.force_mags.push_back(c.force.norm());
-    s.normal_forces.push_back(c.local.Fn);
+  for (std::size_t ci = 0; ci < m.contacts().size(); ++ci) {
+    const ContactOutput& o = m.contact_outputs()[ci];
+    s.force_mags.push_back(o.force.norm());
+    s.normal_forces.push_back(local_components(m.contacts()[ci], o).Fn);
   }
   for (std::size_t i = 0; i < m.balls.size(); ++i)
     s.speeds.push_back(m.balls.vel[i].norm() + m.balls.spin[i].norm());

@@ -6,18 +6,28 @@
 
 namespace rocklab::linear {
 
-void apply_deformability(LinearProps& p, int dim, double R1, double R2, bool ball_facet) {
-  if (p.emod <= 0)
-    return;
-  const double r = ball_facet ? R1 : std::min(R1, R2);
-  const double area =
-      p.user_area > 0 ? p.user_area : (dim == 2 ? 2.0 * r : std::numbers::pi * r * r);
-  const double L = ball_facet ? R1 : R1 + R2;
-  p.kn = area * p.emod / L;
-  p.ks = p.kratio > 0 ? p.kn / p.kratio : 0.0;
+LinearParams make_params(const LinearProps& p, int dim, double R1, double R2, bool ball_facet) {
+  LinearParams q;
+  q.kn = p.kn;
+  q.ks = p.ks;
+  if (p.emod > 0) {
+    const double r = ball_facet ? R1 : std::min(R1, R2);
+    const double area =
+        p.user_area > 0 ? p.user_area : (dim == 2 ? 2.0 * r : std::numbers::pi * r * r);
+    const double L = ball_facet ? R1 : R1 + R2;
+    q.kn = area * p.emod / L;
+    q.ks = p.kratio > 0 ? q.kn / p.kratio : 0.0;
+  }
+  q.fric = p.fric;
+  q.rgap = p.rgap;
+  q.dp_nratio = p.dp_nratio;
+  q.dp_sratio = p.dp_sratio;
+  q.lin_mode = static_cast<std::uint8_t>(p.lin_mode);
+  q.dp_mode = static_cast<std::uint8_t>(p.dp_mode);
+  return q;
 }
 
-void update_linear_part(const LinearProps& p, LinearState& s, const ContactKinematics& k,
+void update_linear_part(const LinearParams& p, LinearState& s, const ContactKinematics& k,
                         EventSink& events, bool slip_allowed) noexcept {
   const double gs = k.gap - p.rgap; // surface gap of the linear interface
   // Normal force, tension positive; the linear interface carries no tension.
@@ -32,7 +42,7 @@ void update_linear_part(const LinearProps& p, LinearState& s, const ContactKinem
   double tss = F0ss - p.ks * k.d_dss;
   double tst = F0st - p.ks * k.d_dst;
   const double limit = -p.fric * s.Fn;
-  const double trial = std::hypot(tss, tst);
+  const double trial = std::sqrt(tss * tss + tst * tst);
   const bool slipping = slip_allowed && trial > limit;
   if (slipping) {
     const double scale = trial > 0 ? limit / trial : 0.0;
@@ -59,7 +69,7 @@ void update_linear_part(const LinearProps& p, LinearState& s, const ContactKinem
 
 void update(LinearContact& c, const ContactKinematics& k, ContactResult& out,
             EventSink& events) noexcept {
-  const LinearProps& p = c.p;
+  const LinearParams& p = c.p;
   LinearState& s = c.s;
   const double gs = k.gap - p.rgap;
   const bool active = gs <= 0.0;
@@ -75,7 +85,6 @@ void update(LinearContact& c, const ContactKinematics& k, ContactResult& out,
     out = ContactResult{};
     return;
   }
-  s.active = true;
   update_linear_part(p, s, k, events);
 
   // Dashpots: F_n^d = 2 beta_n sqrt(m_c kn) v_n (opposes opening), shear opposes sliding.
@@ -95,9 +104,6 @@ void update(LinearContact& c, const ContactKinematics& k, ContactResult& out,
     // Dissipation: minus the work of the dashpot force on the relative displacement.
     s.E_dashpot -= -Fdn * k.d_dn + Fdss * k.d_dss + Fdst * k.d_dst;
   }
-  s.Fdn = Fdn;
-  s.Fdss = Fdss;
-  s.Fdst = Fdst;
   out = ContactResult{s.Fn + Fdn, s.Fss + Fdss, s.Fst + Fdst, 0, 0, 0};
 }
 

@@ -23,28 +23,39 @@ struct LinearProps {
   double user_area = 0; ///< constant area for deformability [m^2], 0 = from the radii
 };
 
+/// The per-contact copy of what the update needs (kn, ks set by deformability at creation).
+struct LinearParams {
+  double kn = 0;        ///< normal stiffness [N/m]
+  double ks = 0;        ///< shear stiffness [N/m]
+  double fric = 0;      ///< friction coefficient [-]
+  double rgap = 0;      ///< reference gap [m]
+  double dp_nratio = 0; ///< normal critical damping ratio [-]
+  double dp_sratio = 0; ///< shear critical damping ratio [-]
+  std::uint8_t lin_mode = 0;
+  std::uint8_t dp_mode = 0;
+};
+
 struct LinearState {
-  double Fn = 0;                      ///< linear normal force, > 0 tension [N]
-  double Fss = 0;                     ///< linear shear force along s_c [N]
-  double Fst = 0;                     ///< linear shear force along t_c [N]
-  double Fdn = 0, Fdss = 0, Fdst = 0; ///< dashpot force components [N]
-  bool slip = false;
-  bool active = false;
+  double Fn = 0;        ///< linear normal force, > 0 tension [N]
+  double Fss = 0;       ///< linear shear force along s_c [N]
+  double Fst = 0;       ///< linear shear force along t_c [N]
   double E_slip = 0;    ///< accumulated slip dissipation [J]
   double E_dashpot = 0; ///< accumulated dashpot dissipation [J]
+  bool slip = false;
 };
 
 struct LinearContact {
-  LinearProps p;
+  LinearParams p;
   LinearState s;
 };
 
 namespace linear {
 
-/// Apply the deformability method: kn = A E* / L, ks = kn / kappa* (kappa* = 0 gives ks = 0).
-/// A = 2 r (2D, unit thickness) or pi r^2 (3D), r = min(R1, R2) (R1 for ball-facet);
-/// L = R1 + R2 (R1 for ball-facet). Same construction as the pbond's Eq. 16.
-void apply_deformability(LinearProps& p, int dim, double R1, double R2, bool ball_facet);
+/// Per-contact parameters from the assigned properties. With E* > 0 the deformability method sets
+/// kn = A E* / L, ks = kn / kappa* (kappa* = 0 gives ks = 0), A = 2 r (2D, unit thickness) or
+/// pi r^2 (3D), r = min(R1, R2) (R1 for ball-facet), L = R1 + R2 (R1 for ball-facet); the same
+/// construction as the pbond's Eq. 16.
+LinearParams make_params(const LinearProps& p, int dim, double R1, double R2, bool ball_facet);
 
 /// Force-displacement update of the linear and dashpot components.
 void update(LinearContact& c, const ContactKinematics& k, ContactResult& out,
@@ -53,7 +64,7 @@ void update(LinearContact& c, const ContactKinematics& k, ContactResult& out,
 /// Update of the linear component only, written so bonded models can reuse it:
 /// returns the linear force in `s` and accumulates slip energy. `slip_allowed` is false for
 /// models that suppress slip while bonded.
-void update_linear_part(const LinearProps& p, LinearState& s, const ContactKinematics& k,
+void update_linear_part(const LinearParams& p, LinearState& s, const ContactKinematics& k,
                         EventSink& events, bool slip_allowed = true) noexcept;
 
 inline ContactStiffness stiffness(const LinearContact& c) {

@@ -66,9 +66,7 @@ inline std::uint32_t create_contact_data(ModelBatches& b, const ModelProps& prop
       [&](const auto& p) -> std::uint32_t {
         using P = std::decay_t<decltype(p)>;
         if constexpr (std::is_same_v<P, LinearProps>) {
-          LinearContact c{p, {}};
-          linear::apply_deformability(c.p, dim, R1, R2, ball_facet);
-          b.linear.push_back(c);
+          b.linear.push_back(LinearContact{linear::make_params(p, dim, R1, R2, ball_facet), {}});
           return static_cast<std::uint32_t>(b.linear.size() - 1);
         }
       },

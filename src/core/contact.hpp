@@ -25,15 +25,25 @@ struct Contact {
   ModelKind model = ModelKind::Linear;
   std::uint32_t slot = 0; ///< index into the model's batch
   bool initialized = false;
+  Vec3 n = Vec3::UnitX(); ///< normal, from piece 1 to piece 2
+  Vec3 s = Vec3::UnitY(); ///< contact-plane s axis
+  Vec3 t = Vec3::UnitZ(); ///< contact-plane t axis, n = s x t
+  double gap = 0;         ///< contact gap g_c, > 0 open [m]
+};
+
+/// What one force-displacement update produces for a contact, kept in its own compact array
+/// (index = contact index) so that summing into bodies reads only this.
+struct ContactOutput {
   Vec3 xc = Vec3::Zero();     ///< contact location [m]
-  Vec3 n = Vec3::UnitX();     ///< normal, from piece 1 to piece 2
-  Vec3 s = Vec3::UnitY();     ///< contact-plane s axis
-  Vec3 t = Vec3::UnitZ();     ///< contact-plane t axis, n = s x t
-  double gap = 0;             ///< contact gap g_c, > 0 open [m]
   Vec3 force = Vec3::Zero();  ///< force on piece 2 at xc, global [N]
   Vec3 moment = Vec3::Zero(); ///< moment on piece 2, global [N m]
-  ContactResult local;        ///< force and moment in contact-plane coordinates
   ContactStiffness stiff;     ///< stiffness for the time-step estimate
 };
+
+/// Force and moment in contact-plane coordinates (Fn > 0 tension).
+inline ContactResult local_components(const Contact& c, const ContactOutput& o) {
+  return {-o.force.dot(c.n), o.force.dot(c.s),  o.force.dot(c.t),
+          o.moment.dot(c.n), o.moment.dot(c.s), o.moment.dot(c.t)};
+}
 
 } // namespace rocklab

@@ -203,13 +203,17 @@ void Model::detect() {
 
   // Merge the candidates with the existing contacts (both sorted by key).
   new_contacts_.clear();
+  new_outputs_.clear();
   new_batches_.clear();
   std::size_t a = 0, b = 0;
-  auto keep = [&](Contact c) {
+  auto keep = [&](std::size_t ci) {
+    Contact c = contacts_[ci];
     c.slot = move_contact_data(new_batches_, batches_, c.model, c.slot);
     new_contacts_.push_back(c);
+    new_outputs_.push_back(outputs_[ci]);
   };
-  auto retire = [&](const Contact& c) {
+  auto retire = [&](std::size_t ci) {
+    const Contact& c = contacts_[ci];
     visit_contact(batches_, c.model, c.slot, [&](const auto& data) {
       ContactEnergy e = contact_energy(data);
       e.strain = e.bond_strain = 0; // stored energy leaves with the contact
@@ -220,7 +224,7 @@ void Model::detect() {
     ev.step = step_;
     ev.time = time_;
     ev.contact = c.key;
-    ev.position = c.xc;
+    ev.position = outputs_[ci].xc;
     ev.normal = c.n;
     ev.gap = c.gap;
     pending_events_.push_back(ev);
@@ -249,9 +253,11 @@ void Model::detect() {
     const double R1 = balls.radius[end1];
     const double R2 = facet ? 0.0 : balls.radius[end2];
     c.slot = create_contact_data(new_batches_, rule->props, settings.dim, R1, R2, facet);
+    ContactOutput o;
     visit_contact(new_batches_, c.model, c.slot,
-                  [&](const auto& data) { c.stiff = contact_stiffness(data); });
+                  [&](const auto& data) { o.stiff = contact_stiffness(data); });
     new_contacts_.push_back(c);
+    new_outputs_.push_back(o);
     Event ev;
     ev.type = EventType::ContactCreated;
     ev.step = step_;
@@ -262,21 +268,23 @@ void Model::detect() {
   while (a < contacts_.size() || b < candidate_keys_.size()) {
     if (b == candidate_keys_.size() ||
         (a < contacts_.size() && contacts_[a].key < candidate_keys_[b])) {
-      const Contact& c = contacts_[a++];
+      const Contact& c = contacts_[a];
       const bool alive = visit_contact(batches_, c.model, c.slot,
                                        [](const auto& data) { return contact_keeps_alive(data); });
       if (alive)
-        keep(c);
+        keep(a);
       else
-        retire(c);
+        retire(a);
+      ++a;
     } else if (a == contacts_.size() || candidate_keys_[b] < contacts_[a].key) {
       create(candidate_keys_[b++]);
     } else {
-      keep(contacts_[a++]);
+      keep(a++);
       ++b;
     }
   }
   std::swap(contacts_, new_contacts_);
+  std::swap(outputs_, new_outputs_);
   std::swap(batches_, new_batches_);
 
   // Ball -> contact adjacency in contact order, for a deterministic force sum.
@@ -320,6 +328,7 @@ void Model::force_displacement(double dt) {
 #pragma omp for schedule(static)
     for (std::size_t ci = 0; ci < nc; ++ci) {
       Contact& c = contacts_[ci];
+      ContactOutput& out = outputs_[ci];
       const std::size_t i1 = static_cast<std::size_t>(c.end1);
       const Vec3& x1 = balls.pos[i1];
       const double R1 = balls.radius[i1];
@@ -371,7 +380,7 @@ void Model::force_displacement(double dt) {
       if (g.gap < -std::min(R1, c.kind == ContactKind::BallBall ? R2 : R1) || through ||
           !std::isfinite(g.gap))
         blowup = std::min(blowup, ci);
-      c.xc = g.xc;
+      out.xc = g.xc;
       c.n = g.n;
       c.gap = g.gap;
 
@@ -383,23 +392,23 @@ void Model::force_displacement(double dt) {
       k.R2 = R2;
       k.mass_eff = m_eff;
       k.ball_facet = c.kind == ContactKind::BallFacet;
-      relative_increments(c.xc, c.n, c.s, c.t, x1, balls.vel[i1], balls.spin[i1], xb2, v2, w2, dt,
+      relative_increments(out.xc, c.n, c.s, c.t, x1, balls.vel[i1], balls.spin[i1], xb2, v2, w2, dt,
                           k);
       const std::size_t first_event = events.size();
       EventSink sink{&events, c.key, 0};
+      ContactResult r;
       visit_contact(batches_, c.model, c.slot, [&](auto& data) {
-        update_contact(data, k, c.local, sink);
-        c.stiff = contact_stiffness(data);
+        update_contact(data, k, r, sink);
+        out.stiff = contact_stiffness(data);
       });
-      const ContactResult& r = c.local;
-      c.force = -r.Fn * c.n + r.Fss * c.s + r.Fst * c.t;
-      c.moment = r.Mt * c.n + r.Mbs * c.s + r.Mbt * c.t;
+      out.force = -r.Fn * c.n + r.Fss * c.s + r.Fst * c.t;
+      out.moment = r.Mt * c.n + r.Mbs * c.s + r.Mbt * c.t;
       for (std::size_t e = first_event; e < events.size(); ++e) {
         Event& ev = events[e];
         ev.step = step_;
         ev.time = time_;
         ev.normal = c.n;
-        ev.position = c.xc + ev.position.y() * c.s + ev.position.z() * c.t;
+        ev.position = out.xc + ev.position.y() * c.s + ev.position.z() * c.t;
         if (ev.gap == 0)
           ev.gap = c.gap;
       }
@@ -425,7 +434,7 @@ void Model::force_displacement(double dt) {
     const Vec3& xi = balls.pos[i];
     for (std::int32_t a = adj_start_[i]; a < adj_start_[i + 1]; ++a) {
       const std::int32_t item = adj_items_[static_cast<std::size_t>(a)];
-      const Contact& c = contacts_[static_cast<std::size_t>(item >> 1)];
+      const ContactOutput& c = outputs_[static_cast<std::size_t>(item >> 1)];
       const double side = (item & 1) ? 1.0 : -1.0; // force acts on end2, reaction on end1
       const Vec3 f = side * c.force;
       const Vec3 arm = c.xc - xi;
@@ -447,12 +456,14 @@ void Model::force_displacement(double dt) {
     w.force.setZero();
     w.moment.setZero();
   }
-  for (const Contact& c : contacts_) {
+  for (std::size_t ci = 0; ci < nc; ++ci) {
+    const Contact& c = contacts_[ci];
     if (c.kind != ContactKind::BallFacet)
       continue;
+    const ContactOutput& o = outputs_[ci];
     Wall& w = walls[static_cast<std::size_t>(c.end2)];
-    w.force += c.force;
-    w.moment += c.moment + (c.xc - w.center).cross(c.force);
+    w.force += o.force;
+    w.moment += o.moment + (o.xc - w.center).cross(o.force);
   }
 
   if (blowup != none) {
@@ -644,7 +655,7 @@ double Model::mean_unbalanced_force_ratio() const {
     acc[0] += std::sqrt(s);
   });
   const auto cf = block_sum<2>(contacts_.size(), [&](std::size_t ci, std::array<double, 2>& acc) {
-    const double f = contacts_[ci].force.norm();
+    const double f = outputs_[ci].force.norm();
     if (f > 0) {
       acc[0] += f;
       acc[1] += 1;
@@ -664,9 +675,8 @@ void Model::drain_events(std::vector<Event>& out) {
 
 std::size_t Model::active_contact_count() const {
   std::size_t count = 0;
-  for (const Contact& c : contacts_)
-    if (c.local.Fn != 0 || c.local.Fss != 0 || c.local.Fst != 0 || c.local.Mt != 0 ||
-        c.local.Mbs != 0 || c.local.Mbt != 0)
+  for (const ContactOutput& o : outputs_)
+    if (o.force != Vec3::Zero() || o.moment != Vec3::Zero())
       ++count;
   return count;
 }

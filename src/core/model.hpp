@@ -60,6 +60,8 @@ public:
   double timestep() const { return dt_; }
   double margin() const { return margin_; }
   const std::vector<Contact>& contacts() const { return contacts_; }
+  /// Location, force, moment and stiffness of each contact (same index as contacts()).
+  const std::vector<ContactOutput>& contact_outputs() const { return outputs_; }
   const ModelBatches& batches() const { return batches_; }
 
   /// Current energies (stored partitions summed over contacts, accumulated ones from the ledger).
@@ -79,9 +81,11 @@ private:
   bool needs_detection() const;
 
   std::vector<Contact> contacts_;
+  std::vector<ContactOutput> outputs_;
   ModelBatches batches_;
   // Scratch storage reused between detections (no allocation in the steady cycle).
   std::vector<Contact> new_contacts_;
+  std::vector<ContactOutput> new_outputs_;
   ModelBatches new_batches_;
   std::vector<std::uint64_t> candidate_keys_;
   std::vector<std::vector<std::uint64_t>> thread_keys_;

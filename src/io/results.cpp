@@ -84,21 +84,23 @@ nlohmann::json results_json(const Model& m, const EventCounts& counts,
   }
   out["walls"] = std::move(walls);
   nlohmann::json contacts = nlohmann::json::array();
-  for (const Contact& c : m.contacts()) {
+  for (std::size_t ci = 0; ci < m.contacts().size(); ++ci) {
+    const Contact& c = m.contacts()[ci];
+    const ContactOutput& o = m.contact_outputs()[ci];
+    const ContactResult local = local_components(c, o);
     const bool bb = c.kind == ContactKind::BallBall;
-    nlohmann::json jc{
-        {"kind", bb ? "ball-ball" : "ball-facet"},
-        {"model", std::string(model_name(c.model))},
-        {"end1", b.id[static_cast<std::size_t>(c.end1)]},
-        {"end2", bb ? nlohmann::json(b.id[static_cast<std::size_t>(c.end2)])
-                    : nlohmann::json(m.walls[static_cast<std::size_t>(c.end2)].name)},
-        {"position", vec_json(c.xc, dim)},
-        {"normal", vec_json(c.n, dim)},
-        {"gap", c.gap},
-        {"force", vec_json(c.force, dim)},
-        {"moment", dim == 2 ? nlohmann::json(c.moment.z()) : vec_json(c.moment, dim)},
-        {"force_local", {{"Fn", c.local.Fn}, {"Fss", c.local.Fss}, {"Fst", c.local.Fst}}},
-        {"moment_local", {{"Mt", c.local.Mt}, {"Mbs", c.local.Mbs}, {"Mbt", c.local.Mbt}}}};
+    nlohmann::json jc{{"kind", bb ? "ball-ball" : "ball-facet"},
+                      {"model", std::string(model_name(c.model))},
+                      {"end1", b.id[static_cast<std::size_t>(c.end1)]},
+                      {"end2", bb ? nlohmann::json(b.id[static_cast<std::size_t>(c.end2)])
+                                  : nlohmann::json(m.walls[static_cast<std::size_t>(c.end2)].name)},
+                      {"position", vec_json(o.xc, dim)},
+                      {"normal", vec_json(c.n, dim)},
+                      {"gap", c.gap},
+                      {"force", vec_json(o.force, dim)},
+                      {"moment", dim == 2 ? nlohmann::json(o.moment.z()) : vec_json(o.moment, dim)},
+                      {"force_local", {{"Fn", local.Fn}, {"Fss", local.Fss}, {"Fst", local.Fst}}},
+                      {"moment_local", {{"Mt", local.Mt}, {"Mbs", local.Mbs}, {"Mbt", local.Mbt}}}};
     visit_contact(m.batches(), c.model, c.slot, [&](const auto& data) {
       using T = std::decay_t<decltype(data)>;
       if constexpr (std::is_same_v<T, LinearContact>) {
