@@ -24,6 +24,7 @@ struct ContactKinematics {
   double R2 = 0;       ///< radius of piece 2, 0 for a facet [m]
   double mass_eff = 0; ///< m1 m2 / (m1 + m2), or m1 for ball-facet [kg]
   bool ball_facet = false;
+  Vec3 n = Vec3::UnitX(), s = Vec3::UnitY(), t = Vec3::UnitZ(); ///< contact-plane axes
 };
 
 /// Output of one update: force and moment acting on piece 2 at the contact location, in

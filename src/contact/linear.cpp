@@ -67,25 +67,29 @@ void update_linear_part(const LinearParams& p, LinearState& s, const ContactKine
   }
 }
 
-void update(LinearContact& c, const ContactKinematics& k, ContactResult& out,
-            EventSink& events) noexcept {
+void update(LinearContact& c, const ContactKinematics& k, ContactResult& out, EventSink& events,
+            bool force_active) noexcept {
   const LinearParams& p = c.p;
   LinearState& s = c.s;
   const double gs = k.gap - p.rgap;
-  const bool active = gs <= 0.0;
-  if (!active) {
-    // Inactive: the force-displacement law is skipped and the forces vanish.
-    if (s.slip) {
-      Event e;
-      e.type = EventType::SlipChange;
-      e.mode = 1;
-      events.raise(e);
-    }
-    s = LinearState{.E_slip = s.E_slip, .E_dashpot = s.E_dashpot};
-    out = ContactResult{};
-    return;
+  const bool open = gs > 0.0;
+  if (open && s.slip) {
+    Event e;
+    e.type = EventType::SlipChange;
+    e.mode = 1;
+    events.raise(e);
   }
-  update_linear_part(p, s, k, events);
+  if (open) {
+    // The linear interface is open: no linear force. The contact stays active only when a
+    // bonded model says so, and then only its dashpots act.
+    s = LinearState{.E_slip = s.E_slip, .E_dashpot = s.E_dashpot};
+    if (!force_active) {
+      out = ContactResult{};
+      return;
+    }
+  } else {
+    update_linear_part(p, s, k, events);
+  }
 
   // Dashpots: F_n^d = 2 beta_n sqrt(m_c kn) v_n (opposes opening), shear opposes sliding.
   double Fdn = 0, Fdss = 0, Fdst = 0;

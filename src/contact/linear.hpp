@@ -57,9 +57,10 @@ namespace linear {
 /// construction as the pbond's Eq. 16.
 LinearParams make_params(const LinearProps& p, int dim, double R1, double R2, bool ball_facet);
 
-/// Force-displacement update of the linear and dashpot components.
-void update(LinearContact& c, const ContactKinematics& k, ContactResult& out,
-            EventSink& events) noexcept;
+/// Force-displacement update of the linear and dashpot components. `force_active` keeps the
+/// dashpots working while the gap is open (a bonded contact of a bonded model is active).
+void update(LinearContact& c, const ContactKinematics& k, ContactResult& out, EventSink& events,
+            bool force_active = false) noexcept;
 
 /// Update of the linear component only, written so bonded models can reuse it:
 /// returns the linear force in `s` and accumulates slip energy. `slip_allowed` is false for

@@ -1,85 +1,189 @@
-// Registry of contact models: one enum value, one batch, one props alternative per model.
-// Adding a model = its file pair + one line in each of the three lists below + its overloads.
+// Registry of contact models: one enum value, one batch, one props alternative per model, and
+// one case in each dispatch function below. The engine calls only these functions.
 #pragma once
 
+#include "contact/flat_joint.hpp"
 #include "contact/linear.hpp"
+#include "contact/parallel_bond.hpp"
+#include "contact/smooth_joint.hpp"
 
+#include <span>
 #include <string_view>
 #include <variant>
 #include <vector>
 
 namespace rocklab {
 
-enum class ModelKind : std::uint8_t { Linear };
+enum class ModelKind : std::uint8_t { Linear, PBond, FlatJoint, SmoothJoint };
 
 inline constexpr std::string_view model_name(ModelKind k) {
   switch (k) {
   case ModelKind::Linear:
     return "linear";
+  case ModelKind::PBond:
+    return "linearpbond";
+  case ModelKind::FlatJoint:
+    return "flatjoint";
+  case ModelKind::SmoothJoint:
+    return "smoothjoint";
   }
   return "unknown";
 }
 
-/// Per-model contiguous storage of contact data (properties + state).
+/// Per-model contiguous storage of contact data (parameters + state).
 struct ModelBatches {
   std::vector<LinearContact> linear;
+  std::vector<PBondContact> pbond;
+  std::vector<FlatJointContact> flatjoint;
+  std::vector<FlatJointElement> fj_elements; ///< elements of all flat joints, contact by contact
+  std::vector<SmoothJointContact> smoothjoint;
 
-  void clear() { linear.clear(); }
+  void clear() {
+    linear.clear();
+    pbond.clear();
+    flatjoint.clear();
+    fj_elements.clear();
+    smoothjoint.clear();
+  }
+  std::span<FlatJointElement> elements(const FlatJointContact& c) {
+    return {fj_elements.data() + c.elem, c.n_elem};
+  }
+  std::span<const FlatJointElement> elements(const FlatJointContact& c) const {
+    return {fj_elements.data() + c.elem, c.n_elem};
+  }
 };
 
-/// Properties a scene assigns to a class of contacts; the alternative selects the model.
-using ModelProps = std::variant<LinearProps>;
+/// Properties a scene assigns to a class of contacts; the alternative selects the model
+/// (same order as ModelKind).
+using ModelProps = std::variant<LinearProps, PBondProps, FlatJointProps, SmoothJointProps>;
 
-inline ModelKind kind_of(const ModelProps& p) {
-  return static_cast<ModelKind>(p.index());
-}
+inline ModelKind kind_of(const ModelProps& p) { return static_cast<ModelKind>(p.index()); }
 
-/// Call f with the contact data of the given model kind and slot.
-template <class Batches, class F>
-decltype(auto) visit_contact(Batches& b, ModelKind kind, std::uint32_t slot, F&& f) {
-  switch (kind) {
+/// Geometry a model may need when it is created.
+struct CreationInfo {
+  int dim = 3;
+  double R1 = 0, R2 = 0; ///< piece radii (R2 = 0 for a facet)
+  bool ball_facet = false;
+  double gap = 0;            ///< contact gap at creation [m]
+  Vec3 n = Vec3::UnitX();    ///< contact normal at creation
+};
+
+inline std::uint32_t create_contact_data(ModelBatches& b, const ModelProps& props,
+                                         const CreationInfo& ci) {
+  switch (kind_of(props)) {
   case ModelKind::Linear:
-    return f(b.linear[slot]);
+    b.linear.push_back(LinearContact{
+        linear::make_params(std::get<LinearProps>(props), ci.dim, ci.R1, ci.R2, ci.ball_facet),
+        {}});
+    return static_cast<std::uint32_t>(b.linear.size() - 1);
+  case ModelKind::PBond:
+    b.pbond.push_back(pbond::make(std::get<PBondProps>(props), ci.dim, ci.R1, ci.R2,
+                                  ci.ball_facet, ci.gap));
+    return static_cast<std::uint32_t>(b.pbond.size() - 1);
+  case ModelKind::FlatJoint:
+    b.flatjoint.push_back(flatjoint::make(std::get<FlatJointProps>(props), ci.dim, ci.R1, ci.R2,
+                                          ci.ball_facet, b.fj_elements));
+    return static_cast<std::uint32_t>(b.flatjoint.size() - 1);
+  case ModelKind::SmoothJoint:
+    b.smoothjoint.push_back(smoothjoint::make(std::get<SmoothJointProps>(props), ci.dim, ci.R1,
+                                              ci.R2, ci.n, ci.gap));
+    return static_cast<std::uint32_t>(b.smoothjoint.size() - 1);
   }
   __builtin_unreachable();
 }
 
-// Uniform overloads used by the engine.
-inline void update_contact(LinearContact& c, const ContactKinematics& k, ContactResult& out,
-                           EventSink& ev) noexcept {
-  linear::update(c, k, out, ev);
-}
-inline ContactStiffness contact_stiffness(const LinearContact& c) {
-  return linear::stiffness(c);
-}
-inline ContactEnergy contact_energy(const LinearContact& c) {
-  return linear::energy(c);
-}
-inline bool contact_keeps_alive(const LinearContact& c) {
-  return linear::keeps_alive(c);
-}
-
-/// Build the per-contact data for a new contact from the assigned properties.
-inline std::uint32_t create_contact_data(ModelBatches& b, const ModelProps& props, int dim,
-                                         double R1, double R2, bool ball_facet) {
-  return std::visit(
-      [&](const auto& p) -> std::uint32_t {
-        using P = std::decay_t<decltype(p)>;
-        if constexpr (std::is_same_v<P, LinearProps>) {
-          b.linear.push_back(LinearContact{linear::make_params(p, dim, R1, R2, ball_facet), {}});
-          return static_cast<std::uint32_t>(b.linear.size() - 1);
-        }
-      },
-      props);
-}
-
-/// Move the data of one contact from one batch set to another (used when the list is rebuilt).
-inline std::uint32_t move_contact_data(ModelBatches& to, ModelBatches& from, ModelKind kind,
+/// Move the data of one contact into another batch set (used when the list is rebuilt).
+inline std::uint32_t move_contact_data(ModelBatches& to, const ModelBatches& from, ModelKind kind,
                                        std::uint32_t slot) {
   switch (kind) {
   case ModelKind::Linear:
     to.linear.push_back(from.linear[slot]);
     return static_cast<std::uint32_t>(to.linear.size() - 1);
+  case ModelKind::PBond:
+    to.pbond.push_back(from.pbond[slot]);
+    return static_cast<std::uint32_t>(to.pbond.size() - 1);
+  case ModelKind::FlatJoint: {
+    FlatJointContact c = from.flatjoint[slot];
+    const auto e = from.elements(c);
+    c.elem = static_cast<std::uint32_t>(to.fj_elements.size());
+    to.fj_elements.insert(to.fj_elements.end(), e.begin(), e.end());
+    to.flatjoint.push_back(c);
+    return static_cast<std::uint32_t>(to.flatjoint.size() - 1);
+  }
+  case ModelKind::SmoothJoint:
+    to.smoothjoint.push_back(from.smoothjoint[slot]);
+    return static_cast<std::uint32_t>(to.smoothjoint.size() - 1);
+  }
+  __builtin_unreachable();
+}
+
+/// Force-displacement update of one contact; out is in contact-plane coordinates.
+inline void update_contact(ModelBatches& b, ModelKind kind, std::uint32_t slot,
+                           const ContactKinematics& k, ContactResult& out,
+                           EventSink& ev) noexcept {
+  switch (kind) {
+  case ModelKind::Linear:
+    linear::update(b.linear[slot], k, out, ev);
+    return;
+  case ModelKind::PBond:
+    pbond::update(b.pbond[slot], k, out, ev);
+    return;
+  case ModelKind::FlatJoint: {
+    FlatJointContact& c = b.flatjoint[slot];
+    flatjoint::update(c, b.elements(c), k, out, ev);
+    return;
+  }
+  case ModelKind::SmoothJoint: {
+    // The smooth joint works on the joint plane: give it the global increment, take back the
+    // global force in contact-plane components.
+    const Vec3 d = k.d_dn * k.n + k.d_dss * k.s + k.d_dst * k.t;
+    Vec3 F;
+    smoothjoint::update(b.smoothjoint[slot], d, k.gap, F, ev);
+    out = ContactResult{-F.dot(k.n), F.dot(k.s), F.dot(k.t), 0, 0, 0};
+    return;
+  }
+  }
+}
+
+inline ContactStiffness contact_stiffness(const ModelBatches& b, ModelKind kind,
+                                          std::uint32_t slot) {
+  switch (kind) {
+  case ModelKind::Linear:
+    return linear::stiffness(b.linear[slot]);
+  case ModelKind::PBond:
+    return pbond::stiffness(b.pbond[slot]);
+  case ModelKind::FlatJoint:
+    return flatjoint::stiffness(b.flatjoint[slot]);
+  case ModelKind::SmoothJoint:
+    return smoothjoint::stiffness(b.smoothjoint[slot]);
+  }
+  __builtin_unreachable();
+}
+
+inline ContactEnergy contact_energy(const ModelBatches& b, ModelKind kind, std::uint32_t slot) {
+  switch (kind) {
+  case ModelKind::Linear:
+    return linear::energy(b.linear[slot]);
+  case ModelKind::PBond:
+    return pbond::energy(b.pbond[slot]);
+  case ModelKind::FlatJoint:
+    return flatjoint::energy(b.flatjoint[slot], b.elements(b.flatjoint[slot]));
+  case ModelKind::SmoothJoint:
+    return smoothjoint::energy(b.smoothjoint[slot]);
+  }
+  __builtin_unreachable();
+}
+
+inline bool contact_keeps_alive(const ModelBatches& b, ModelKind kind, std::uint32_t slot) {
+  switch (kind) {
+  case ModelKind::Linear:
+    return linear::keeps_alive(b.linear[slot]);
+  case ModelKind::PBond:
+    return pbond::keeps_alive(b.pbond[slot]);
+  case ModelKind::FlatJoint:
+    return flatjoint::keeps_alive(b.flatjoint[slot], b.elements(b.flatjoint[slot]));
+  case ModelKind::SmoothJoint:
+    return smoothjoint::keeps_alive(b.smoothjoint[slot]);
   }
   __builtin_unreachable();
 }

@@ -214,11 +214,9 @@ void Model::detect() {
   };
   auto retire = [&](std::size_t ci) {
     const Contact& c = contacts_[ci];
-    visit_contact(batches_, c.model, c.slot, [&](const auto& data) {
-      ContactEnergy e = contact_energy(data);
-      e.strain = e.bond_strain = 0; // stored energy leaves with the contact
-      retired_ += e;
-    });
+    ContactEnergy e = contact_energy(batches_, c.model, c.slot);
+    e.strain = e.bond_strain = 0; // stored energy leaves with the contact
+    retired_ += e;
     Event ev;
     ev.type = EventType::ContactDeleted;
     ev.step = step_;
@@ -250,12 +248,33 @@ void Model::detect() {
     c.end2 = end2;
     c.kind = facet ? ContactKind::BallFacet : ContactKind::BallBall;
     c.model = kind_of(rule->props);
-    const double R1 = balls.radius[end1];
-    const double R2 = facet ? 0.0 : balls.radius[end2];
-    c.slot = create_contact_data(new_batches_, rule->props, settings.dim, R1, R2, facet);
+    CreationInfo info;
+    info.dim = settings.dim;
+    info.R1 = balls.radius[end1];
+    info.R2 = facet ? 0.0 : balls.radius[end2];
+    info.ball_facet = facet;
+    const Vec3& x1 = balls.pos[end1];
+    if (facet) {
+      double dmin = std::numeric_limits<double>::max();
+      Vec3 xf = x1;
+      for (const Facet& f : walls[static_cast<std::size_t>(end2)].facets) {
+        const Vec3 p = closest_point_on_facet(f, x1);
+        if ((p - x1).squaredNorm() < dmin) {
+          dmin = (p - x1).squaredNorm();
+          xf = p;
+        }
+      }
+      const PlaneGeometry g = ball_facet_plane(x1, info.R1, xf);
+      info.gap = g.gap;
+      info.n = g.n;
+    } else {
+      const PlaneGeometry g = ball_ball_plane(x1, info.R1, balls.pos[end2], info.R2);
+      info.gap = g.gap;
+      info.n = g.n;
+    }
+    c.slot = create_contact_data(new_batches_, rule->props, info);
     ContactOutput o;
-    visit_contact(new_batches_, c.model, c.slot,
-                  [&](const auto& data) { o.stiff = contact_stiffness(data); });
+    o.stiff = contact_stiffness(new_batches_, c.model, c.slot);
     new_contacts_.push_back(c);
     new_outputs_.push_back(o);
     Event ev;
@@ -269,8 +288,7 @@ void Model::detect() {
     if (b == candidate_keys_.size() ||
         (a < contacts_.size() && contacts_[a].key < candidate_keys_[b])) {
       const Contact& c = contacts_[a];
-      const bool alive = visit_contact(batches_, c.model, c.slot,
-                                       [](const auto& data) { return contact_keeps_alive(data); });
+      const bool alive = contact_keeps_alive(batches_, c.model, c.slot);
       if (alive)
         keep(a);
       else
@@ -396,11 +414,12 @@ void Model::force_displacement(double dt) {
                           k);
       const std::size_t first_event = events.size();
       EventSink sink{&events, c.key, 0};
+      k.n = c.n;
+      k.s = c.s;
+      k.t = c.t;
       ContactResult r;
-      visit_contact(batches_, c.model, c.slot, [&](auto& data) {
-        update_contact(data, k, r, sink);
-        out.stiff = contact_stiffness(data);
-      });
+      update_contact(batches_, c.model, c.slot, k, r, sink);
+      out.stiff = contact_stiffness(batches_, c.model, c.slot);
       out.force = -r.Fn * c.n + r.Fss * c.s + r.Fst * c.t;
       out.moment = r.Mt * c.n + r.Mbs * c.s + r.Mbt * c.t;
       for (std::size_t e = first_event; e < events.size(); ++e) {
@@ -627,14 +646,12 @@ EnergyLedger Model::energy() const {
   e.kinetic_rotational = kin[1];
   const auto con = block_sum<5>(contacts_.size(), [&](std::size_t ci, std::array<double, 5>& acc) {
     const Contact& c = contacts_[ci];
-    visit_contact(batches_, c.model, c.slot, [&](const auto& data) {
-      const ContactEnergy ce = contact_energy(data);
-      acc[0] += ce.strain;
-      acc[1] += ce.bond_strain;
-      acc[2] += ce.slip;
-      acc[3] += ce.dashpot;
-      acc[4] += ce.plastic;
-    });
+    const ContactEnergy ce = contact_energy(batches_, c.model, c.slot);
+    acc[0] += ce.strain;
+    acc[1] += ce.bond_strain;
+    acc[2] += ce.slip;
+    acc[3] += ce.dashpot;
+    acc[4] += ce.plastic;
   });
   e.strain = con[0];
   e.bond_strain = con[1];

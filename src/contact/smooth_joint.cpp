@@ -1,0 +1,163 @@
+#include "contact/smooth_joint.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace rocklab {
+
+namespace {
+constexpr double kDeg = std::numbers::pi / 180.0;
+}
+
+Vec3 joint_normal(int dim, double dip_deg, double ddir_deg) {
+  const double p = dip_deg * kDeg, d = ddir_deg * kDeg;
+  if (dim == 2)
+    return Vec3(std::sin(p), std::cos(p), 0); // Eq. 1, 2D
+  return Vec3(std::sin(p) * std::sin(d), std::sin(p) * std::cos(d), std::cos(p)); // Eq. 1, 3D
+}
+
+namespace smoothjoint {
+
+SmoothJointContact make(const SmoothJointProps& p, int dim, double R1, double R2, const Vec3& n_c,
+                        double gap) {
+  SmoothJointContact c;
+  c.kn = p.sj_kn;
+  c.ks = p.sj_ks;
+  c.fric = p.sj_fric;
+  c.tan_da = std::tan(p.sj_da * kDeg);
+  c.ten = p.sj_ten;
+  c.coh = p.sj_coh;
+  c.tan_fa = std::tan(p.sj_fa * kDeg);
+  c.rmul = p.sj_rmul;
+  c.large = p.sj_large;
+  const double R = c.rmul * std::min(R1, R2); // Eq. 2
+  c.A = dim == 2 ? 2 * R : std::numbers::pi * R * R;
+  // Piece 2 lies in surface 2 iff n_c . n_j >= 0; orient n_j from piece 1's surface to 2's.
+  const Vec3 nj = joint_normal(dim, p.dip, p.ddir);
+  c.nj = n_c.dot(nj) >= 0 ? nj : Vec3(-nj);
+  if (p.bond)
+    bond(c, gap, p.bond_gap_lo, p.bond_gap_hi);
+  return c;
+}
+
+void bond(SmoothJointContact& c, double gap, double lo, double hi) {
+  if (gap >= lo && gap <= hi)
+    c.state = 3;
+}
+
+void unbond(SmoothJointContact& c, double gap, double lo, double hi) {
+  if (gap >= lo && gap <= hi)
+    c.state = 0;
+}
+
+void update(SmoothJointContact& c, const Vec3& d_delta, double gap, Vec3& force,
+            EventSink& events) noexcept {
+  const bool bonded = c.state == 3;
+  // Large-strain mode: active only while bonded or overlapping.
+  if (c.large && !bonded && gap >= 0) {
+    c.Fn = 0;
+    c.Fs.setZero();
+    force.setZero();
+    return;
+  }
+  // Eq. 3-4: resolve the increment on the joint.
+  const double d_n = d_delta.dot(c.nj); // > 0 opening
+  const Vec3 d_s = d_delta - d_n * c.nj;
+  c.un -= d_n;
+  c.us += d_s;
+  // Elastic portions: everything while bonded; otherwise the part while the joint gap is < 0.
+  const double g0 = c.gj, g1 = c.gj + d_n;
+  c.gj = g1;
+  double f = 1.0;
+  if (!bonded) {
+    if (g0 >= 0 && g1 >= 0)
+      f = 0;
+    else if (g0 < 0 && g1 >= 0)
+      f = -g0 / (g1 - g0);
+    else if (g0 >= 0 && g1 < 0)
+      f = -g1 / (g0 - g1);
+  }
+  const double kn = c.kn * c.A, ks = c.ks * c.A;
+  const double Fn0 = c.Fn;
+  const Vec3 Fs0 = c.Fs;
+  c.Fn = Fn0 + kn * f * d_n; // Eq. 7
+  if (!bonded)
+    c.Fn = std::min(c.Fn, 0.0);
+  Vec3 trial = Fs0 - ks * f * d_s; // Eq. 8
+  const double trial_mag = trial.norm();
+  auto coulomb = [&](bool dilate) { // Eq. 9-12
+    const double limit = -c.fric * c.Fn;
+    const bool slipping = trial_mag > limit;
+    if (slipping) {
+      c.Fs = trial_mag > 0 ? Vec3(trial * (limit / trial_mag)) : Vec3::Zero();
+      // Dilation while slipping: the compressive normal force grows by
+      // (|Fs*| - Fs^mu) / ks * kn tan(psi) (Eq. 12; stiffnesses times area).
+      if (dilate && ks > 0)
+        c.Fn -= (trial_mag - limit) / ks * kn * c.tan_da;
+    } else {
+      c.Fs = trial;
+    }
+    if (slipping != c.slip) {
+      Event e;
+      e.type = EventType::SlipChange;
+      e.mode = slipping ? 0 : 1;
+      events.raise(e);
+      c.slip = slipping;
+    }
+  };
+  if (!bonded) {
+    coulomb(true);
+  } else {
+    const double tau_c = c.coh - (c.Fn / c.A) * c.tan_fa;
+    int mode = 0;
+    if (c.Fn >= c.ten * c.A)
+      mode = 1;
+    else if (trial_mag >= tau_c * c.A)
+      mode = 2; // Eq. 13
+    if (mode != 0) {
+      Event e;
+      e.type = EventType::BondBreak;
+      e.mode = mode;
+      e.strength = mode == 1 ? c.ten : tau_c;
+      e.energy = energy(c).strain;
+      e.normal = c.nj;
+      e.size = 2 * std::sqrt(c.A / std::numbers::pi);
+      events.raise(e);
+      c.state = static_cast<std::uint8_t>(mode);
+      if (mode == 1 || c.Fn > 0) { // Eq. 14
+        c.Fn = 0;
+        c.Fs.setZero();
+      } else {
+        coulomb(false); // limited by Eq. 10, no dilation
+      }
+    } else {
+      c.Fs = trial; // Eq. 15
+    }
+  }
+  // Slip energy: minus the work of the mean shear force on the slip part of the increment.
+  if (ks > 0) {
+    const Vec3 elastic = -(c.Fs - Fs0) / ks;
+    const Vec3 mu = d_s - elastic;
+    if (c.slip)
+      c.E_slip -= 0.5 * (Fs0 + c.Fs).dot(mu); // Eq. 17
+  }
+  force = -c.Fn * c.nj + c.Fs; // Eq. 5-6
+}
+
+ContactStiffness stiffness(const SmoothJointContact& c) {
+  return {(c.kn + c.ks) * c.A, c.ks * c.A, 0.0};
+}
+
+ContactEnergy energy(const SmoothJointContact& c) {
+  ContactEnergy e; // Eq. 16 with the stiffnesses times the joint area
+  if (c.kn > 0)
+    e.strain += 0.5 * c.Fn * c.Fn / (c.kn * c.A);
+  if (c.ks > 0)
+    e.strain += 0.5 * c.Fs.squaredNorm() / (c.ks * c.A);
+  e.slip = c.E_slip;
+  return e;
+}
+
+} // namespace smoothjoint
+} // namespace rocklab
