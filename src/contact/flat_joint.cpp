@@ -87,12 +87,12 @@ void add_segment(double s0, double t0, double s1, double t1, Moments& m) {
 void add_arc(double rho, double a, double b, Moments& m) {
   auto P = [](double x) {
     const double c = std::cos(x), s = std::sin(x);
-    return std::array<double, 6>{x / 2 + std::sin(2 * x) / 4,           // cos^2
-                                 s - s * s * s / 3,                        // cos^3
-                                 -c * c * c / 3,                           // cos^2 sin
+    return std::array<double, 6>{x / 2 + std::sin(2 * x) / 4, // cos^2
+                                 s - s * s * s / 3,           // cos^3
+                                 -c * c * c / 3,              // cos^2 sin
                                  3 * x / 8 + std::sin(2 * x) / 4 + std::sin(4 * x) / 32, // cos^4
-                                 -c * c * c * c / 4,                       // cos^3 sin
-                                 x / 8 - std::sin(4 * x) / 32};            // cos^2 sin^2
+                                 -c * c * c * c / 4,            // cos^3 sin
+                                 x / 8 - std::sin(4 * x) / 32}; // cos^2 sin^2
   };
   const auto pa = P(a), pb = P(b);
   const double r2 = rho * rho, r3 = r2 * rho, r4 = r3 * rho;
@@ -371,8 +371,8 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
         Moments m;
         if (bonded) {
           const double R2 = R * R, R3 = R2 * R, R4 = R3 * R;
-          m = {geo.A[i] * R2, geo.s[i] * geo.A[i] * R3, geo.t[i] * geo.A[i] * R3,
-               geo.Ixx[i] * R4, geo.Ixy[i] * R4, geo.Iyy[i] * R4};
+          m = {geo.A[i] * R2,   geo.s[i] * geo.A[i] * R3, geo.t[i] * geo.A[i] * R3,
+               geo.Ixx[i] * R4, geo.Ixy[i] * R4,          geo.Iyy[i] * R4};
         } else {
           m = clipped_moments(geo.r1[i] * R, geo.r2[i] * R, geo.a1[i], geo.a2[i], c.gs, bs, bt);
         }

@@ -13,30 +13,30 @@ namespace rocklab {
 
 /// Properties a scene assigns (names of the memo's Table 3/5). Stresses in Pa, stiffness Pa/m.
 struct FlatJointProps {
-  int fj_Nr = 2;          ///< elements in the radial direction (2D: number of elements), >= 1
-  int fj_Nal = 4;         ///< elements in the circumferential direction (3D), >= 3
-  double fj_rmul = 1.0;   ///< radius multiplier lambda, (0, +inf)
-  double fj_gap0 = 0;     ///< initial surface gap g_o [m], >= 0
-  double fj_kn = 0;       ///< normal stiffness [Pa/m]
-  double fj_ks = 0;       ///< shear stiffness [Pa/m]
-  double fj_fric = 0;     ///< friction coefficient mu
-  double fj_ten = 0;      ///< tensile strength sigma_c [Pa]
-  double fj_coh = 0;      ///< cohesion c [Pa]
-  double fj_fa = 0;       ///< friction angle phi [deg], [0, 90)
-  double fj_emod = 0;     ///< > 0: deformability, kn = E*/L (Eq. 40) [Pa]
-  double fj_kratio = 0;   ///< kappa* = kn/ks for the deformability method
-  bool bond = false;      ///< apply the bond method (all elements) when the contact is created
-  bool fj_exact = false;  ///< 3D: integrate element normal and twist-shear stresses exactly
+  int fj_Nr = 2;         ///< elements in the radial direction (2D: number of elements), >= 1
+  int fj_Nal = 4;        ///< elements in the circumferential direction (3D), >= 3
+  double fj_rmul = 1.0;  ///< radius multiplier lambda, (0, +inf)
+  double fj_gap0 = 0;    ///< initial surface gap g_o [m], >= 0
+  double fj_kn = 0;      ///< normal stiffness [Pa/m]
+  double fj_ks = 0;      ///< shear stiffness [Pa/m]
+  double fj_fric = 0;    ///< friction coefficient mu
+  double fj_ten = 0;     ///< tensile strength sigma_c [Pa]
+  double fj_coh = 0;     ///< cohesion c [Pa]
+  double fj_fa = 0;      ///< friction angle phi [deg], [0, 90)
+  double fj_emod = 0;    ///< > 0: deformability, kn = E*/L (Eq. 40) [Pa]
+  double fj_kratio = 0;  ///< kappa* = kn/ks for the deformability method
+  bool bond = false;     ///< apply the bond method (all elements) when the contact is created
+  bool fj_exact = false; ///< 3D: integrate element normal and twist-shear stresses exactly
 };
 
 /// Element state (memo Table 4, per element).
 struct FlatJointElement {
-  double Fn = 0;            ///< normal force, > 0 tension [N]
-  double Fss = 0, Fst = 0;  ///< shear force [N]
-  double Mbs = 0, Mbt = 0;  ///< bending moment about the element centroid [N m]
-  double Mt = 0;            ///< twisting moment about the element centroid (exact 3D) [N m]
-  double E_slip = 0;        ///< slip energy (Eq. 39) [J]
-  std::uint8_t B = 0;       ///< 0 unbonded, 1 broke in tension, 2 broke in shear, 3 bonded
+  double Fn = 0;           ///< normal force, > 0 tension [N]
+  double Fss = 0, Fst = 0; ///< shear force [N]
+  double Mbs = 0, Mbt = 0; ///< bending moment about the element centroid [N m]
+  double Mt = 0;           ///< twisting moment about the element centroid (exact 3D) [N m]
+  double E_slip = 0;       ///< slip energy (Eq. 39) [J]
+  std::uint8_t B = 0;      ///< 0 unbonded, 1 broke in tension, 2 broke in shear, 3 bonded
   bool slip = false;
 };
 
@@ -53,7 +53,7 @@ struct FlatJointContact {
   // parameters (per contact)
   double kn = 0, ks = 0, fric = 0, ten = 0, coh = 0, tan_fa = 0, rmul = 1, gap0 = 0;
   const FlatJointGeometry* geo = nullptr;
-  std::uint32_t elem = 0;  ///< index of element 1 in the batch's element array
+  std::uint32_t elem = 0; ///< index of element 1 in the batch's element array
   std::uint16_t n_elem = 0;
   bool exact = false;
   // state

@@ -16,8 +16,7 @@ BondSection bond_section(double rmul, int dim, double R1, double R2, bool ball_f
 
 namespace pbond {
 
-PBondContact make(const PBondProps& p, int dim, double R1, double R2, bool ball_facet,
-                  double gap) {
+PBondContact make(const PBondProps& p, int dim, double R1, double R2, bool ball_facet, double gap) {
   PBondContact c;
   c.lp = linear::make_params(p.linear, dim, R1, R2, ball_facet);
   c.p.rmul = p.pb_rmul;
@@ -96,12 +95,12 @@ void update(PBondContact& c, const ContactKinematics& k, ContactResult& out,
   s.A = b.A;
   s.I = b.I;
   s.J = b.J;
-  s.gs += k.d_dn;                     // Eq. 4
-  s.Fn += c.p.kn * b.A * k.d_dn;      // Eq. 6
-  s.Fss -= c.p.ks * b.A * k.d_dss;    // Eq. 7
+  s.gs += k.d_dn;                  // Eq. 4
+  s.Fn += c.p.kn * b.A * k.d_dn;   // Eq. 6
+  s.Fss -= c.p.ks * b.A * k.d_dss; // Eq. 7
   s.Fst -= c.p.ks * b.A * k.d_dst;
   s.Mt = k.dim == 2 ? 0.0 : s.Mt - c.p.ks * b.J * k.d_tt; // Eq. 8
-  s.Mbs -= c.p.kn * b.I * k.d_tbs;    // Eq. 10
+  s.Mbs -= c.p.kn * b.I * k.d_tbs;                        // Eq. 10
   s.Mbt -= c.p.kn * b.I * k.d_tbt;
 
   // Eq. 12: peripheral stresses with the moment-contribution factor.

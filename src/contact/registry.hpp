@@ -57,15 +57,17 @@ struct ModelBatches {
 /// (same order as ModelKind).
 using ModelProps = std::variant<LinearProps, PBondProps, FlatJointProps, SmoothJointProps>;
 
-inline ModelKind kind_of(const ModelProps& p) { return static_cast<ModelKind>(p.index()); }
+inline ModelKind kind_of(const ModelProps& p) {
+  return static_cast<ModelKind>(p.index());
+}
 
 /// Geometry a model may need when it is created.
 struct CreationInfo {
   int dim = 3;
   double R1 = 0, R2 = 0; ///< piece radii (R2 = 0 for a facet)
   bool ball_facet = false;
-  double gap = 0;            ///< contact gap at creation [m]
-  Vec3 n = Vec3::UnitX();    ///< contact normal at creation
+  double gap = 0;         ///< contact gap at creation [m]
+  Vec3 n = Vec3::UnitX(); ///< contact normal at creation
 };
 
 inline std::uint32_t create_contact_data(ModelBatches& b, const ModelProps& props,
@@ -77,16 +79,16 @@ inline std::uint32_t create_contact_data(ModelBatches& b, const ModelProps& prop
         {}});
     return static_cast<std::uint32_t>(b.linear.size() - 1);
   case ModelKind::PBond:
-    b.pbond.push_back(pbond::make(std::get<PBondProps>(props), ci.dim, ci.R1, ci.R2,
-                                  ci.ball_facet, ci.gap));
+    b.pbond.push_back(
+        pbond::make(std::get<PBondProps>(props), ci.dim, ci.R1, ci.R2, ci.ball_facet, ci.gap));
     return static_cast<std::uint32_t>(b.pbond.size() - 1);
   case ModelKind::FlatJoint:
     b.flatjoint.push_back(flatjoint::make(std::get<FlatJointProps>(props), ci.dim, ci.R1, ci.R2,
                                           ci.ball_facet, b.fj_elements));
     return static_cast<std::uint32_t>(b.flatjoint.size() - 1);
   case ModelKind::SmoothJoint:
-    b.smoothjoint.push_back(smoothjoint::make(std::get<SmoothJointProps>(props), ci.dim, ci.R1,
-                                              ci.R2, ci.n, ci.gap));
+    b.smoothjoint.push_back(
+        smoothjoint::make(std::get<SmoothJointProps>(props), ci.dim, ci.R1, ci.R2, ci.n, ci.gap));
     return static_cast<std::uint32_t>(b.smoothjoint.size() - 1);
   }
   __builtin_unreachable();
@@ -119,8 +121,7 @@ inline std::uint32_t move_contact_data(ModelBatches& to, const ModelBatches& fro
 
 /// Force-displacement update of one contact; out is in contact-plane coordinates.
 inline void update_contact(ModelBatches& b, ModelKind kind, std::uint32_t slot,
-                           const ContactKinematics& k, ContactResult& out,
-                           EventSink& ev) noexcept {
+                           const ContactKinematics& k, ContactResult& out, EventSink& ev) noexcept {
   switch (kind) {
   case ModelKind::Linear:
     linear::update(b.linear[slot], k, out, ev);

@@ -13,7 +13,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 Vec3 joint_normal(int dim, double dip_deg, double ddir_deg) {
   const double p = dip_deg * kDeg, d = ddir_deg * kDeg;
   if (dim == 2)
-    return Vec3(std::sin(p), std::cos(p), 0); // Eq. 1, 2D
+    return Vec3(std::sin(p), std::cos(p), 0);                                     // Eq. 1, 2D
   return Vec3(std::sin(p) * std::sin(d), std::sin(p) * std::cos(d), std::cos(p)); // Eq. 1, 3D
 }
 

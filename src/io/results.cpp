@@ -11,16 +11,21 @@ nlohmann::json vec_json(const Vec3& v, int dim) {
     return nlohmann::json::array({v.x(), v.y()});
   return nlohmann::json::array({v.x(), v.y(), v.z()});
 }
-nlohmann::json vec3_json(const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+nlohmann::json vec3_json(const Vec3& v) {
+  return nlohmann::json::array({v.x(), v.y(), v.z()});
+}
 
 } // namespace
 
 nlohmann::json contact_state_json(const ModelBatches& b, const Contact& c, int dim) {
   auto linear_json = [](const LinearParams& p, const LinearState& s) {
-    return nlohmann::json{{"kn", p.kn},         {"ks", p.ks},
-                          {"fric", p.fric},     {"lin_slip", s.slip},
+    return nlohmann::json{{"kn", p.kn},
+                          {"ks", p.ks},
+                          {"fric", p.fric},
+                          {"lin_slip", s.slip},
                           {"lin_force", {{"Fn", s.Fn}, {"Fss", s.Fss}, {"Fst", s.Fst}}},
-                          {"E_slip", s.E_slip}, {"E_dashpot", s.E_dashpot}};
+                          {"E_slip", s.E_slip},
+                          {"E_dashpot", s.E_dashpot}};
   };
   switch (c.model) {
   case ModelKind::Linear: {
@@ -44,9 +49,14 @@ nlohmann::json contact_state_json(const ModelBatches& b, const Contact& c, int d
   case ModelKind::FlatJoint: {
     const FlatJointContact& f = b.flatjoint[c.slot];
     const auto els = b.elements(f);
-    nlohmann::json j{{"fj_radius", f.R},   {"fj_gap", f.gs},     {"fj_kn", f.kn},
-                     {"fj_ks", f.ks},      {"fj_mtype", f.mtype}, {"fj_Nr", f.geo->Nr},
-                     {"fj_Nal", f.geo->Nal}, {"fj_exact", f.exact},
+    nlohmann::json j{{"fj_radius", f.R},
+                     {"fj_gap", f.gs},
+                     {"fj_kn", f.kn},
+                     {"fj_ks", f.ks},
+                     {"fj_mtype", f.mtype},
+                     {"fj_Nr", f.geo->Nr},
+                     {"fj_Nal", f.geo->Nal},
+                     {"fj_exact", f.exact},
                      {"fj_relbr", nlohmann::json::array({f.tbs, f.tbt})},
                      {"fj_relsd", nlohmann::json::array({f.dss, f.dst})}};
     nlohmann::json elements = nlohmann::json::array();
@@ -71,9 +81,15 @@ nlohmann::json contact_state_json(const ModelBatches& b, const Contact& c, int d
   }
   case ModelKind::SmoothJoint: {
     const SmoothJointContact& sj = b.smoothjoint[c.slot];
-    return {{"sj_state", sj.state}, {"sj_slip", sj.slip},   {"sj_fn", sj.Fn},
-            {"sj_fs", vec3_json(sj.Fs)}, {"sj_unorm", vec3_json(sj.nj)}, {"sj_un", sj.un},
-            {"sj_us", vec3_json(sj.us)}, {"sj_gap", sj.gj},  {"sj_area", sj.A},
+    return {{"sj_state", sj.state},
+            {"sj_slip", sj.slip},
+            {"sj_fn", sj.Fn},
+            {"sj_fs", vec3_json(sj.Fs)},
+            {"sj_unorm", vec3_json(sj.nj)},
+            {"sj_un", sj.un},
+            {"sj_us", vec3_json(sj.us)},
+            {"sj_gap", sj.gj},
+            {"sj_area", sj.A},
             {"E_slip", sj.E_slip}};
   }
   }

@@ -13,10 +13,10 @@ double uniform01(std::mt19937_64& rng) {
   return static_cast<double>(rng() >> 11) * 0x1.0p-53;
 }
 
-std::uint8_t parse_fixity(JsonObject& o, int dim) {
-  if (!o.has("fix"))
+std::uint8_t parse_dofs(JsonObject& o, const std::string& key, int dim) {
+  if (!o.has(key))
     return 0;
-  const auto& v = o.raw("fix");
+  const auto& v = o.raw(key);
   const std::vector<std::string> names =
       dim == 2 ? std::vector<std::string>{"x", "y", "rz"}
                : std::vector<std::string>{"x", "y", "z", "rx", "ry", "rz"};
@@ -37,14 +37,18 @@ std::uint8_t parse_fixity(JsonObject& o, int dim) {
   if (v.is_string())
     return bit(v.get<std::string>());
   if (!v.is_array())
-    o.fail("fix", "expected an array of DOF names (" + allowed + "), got " + describe(v));
+    o.fail(key, "expected an array of DOF names (" + allowed + "), got " + describe(v));
   std::uint8_t mask = 0;
   for (const auto& e : v) {
     if (!e.is_string())
-      o.fail("fix", "expected DOF names (" + allowed + "), got " + describe(e));
+      o.fail(key, "expected DOF names (" + allowed + "), got " + describe(e));
     mask |= bit(e.get<std::string>());
   }
   return mask;
+}
+
+std::uint8_t parse_fixity(JsonObject& o, int dim) {
+  return parse_dofs(o, "fix", dim);
 }
 
 void read_ball_motion(JsonObject& o, Model& m, std::size_t i) {
@@ -277,7 +281,7 @@ void read_balls(JsonObject& top, Model& m) {
     throw InputError(top.file() + ": the scene has no balls (give 'balls' or 'generate')");
 }
 
-ModelProps read_linear_props(JsonObject& p) {
+LinearProps read_linear_props(JsonObject& p, bool kn_required) {
   LinearProps lp;
   const bool deform = p.has("emod");
   if (deform && (p.has("kn") || p.has("ks")))
@@ -287,7 +291,8 @@ ModelProps read_linear_props(JsonObject& p) {
     lp.kratio = p.number("kratio", Range::non_negative(), 0.0);
     lp.user_area = p.number("user_area", Range::non_negative(), 0.0, "m^2");
   } else {
-    lp.kn = p.number("kn", Range::non_negative(), std::nullopt, "N/m");
+    lp.kn = p.number("kn", Range::non_negative(),
+                     kn_required ? std::nullopt : std::optional<double>(0.0), "N/m");
     lp.ks = p.number("ks", Range::non_negative(), 0.0, "N/m");
   }
   lp.fric = p.number("fric", Range::non_negative(), 0.0);
@@ -296,8 +301,114 @@ ModelProps read_linear_props(JsonObject& p) {
   lp.dp_nratio = p.number("dp_nratio", Range::closed(0, 1), 0.0);
   lp.dp_sratio = p.number("dp_sratio", Range::closed(0, 1), 0.0);
   lp.dp_mode = static_cast<int>(p.integer("dp_mode", 0, 3, 0));
-  p.finish();
   return lp;
+}
+
+// The bond method at creation: true/false, a maximum gap, or {"gap": [lo, hi]}.
+void read_bond(JsonObject& p, bool default_bond, bool& bond, double& lo, double& hi) {
+  bond = default_bond;
+  lo = -1e300;
+  hi = 0;
+  if (!p.has("bond"))
+    return;
+  const auto& v = p.raw("bond");
+  if (v.is_boolean()) {
+    bond = v.get<bool>();
+  } else if (v.is_number()) {
+    bond = true;
+    hi = v.get<double>();
+  } else if (v.is_object() && v.size() == 1 && v.contains("gap") && v["gap"].is_array() &&
+             v["gap"].size() == 2 && v["gap"][0].is_number() && v["gap"][1].is_number() &&
+             v["gap"][0].get<double>() <= v["gap"][1].get<double>()) {
+    bond = true;
+    lo = v["gap"][0].get<double>();
+    hi = v["gap"][1].get<double>();
+  } else {
+    p.fail("bond", "expected true/false, a maximum gap in m, or {\"gap\": [lo, hi]} with "
+                   "lo <= hi, got " +
+                       describe(v));
+  }
+}
+
+const Range kAngle = Range::half_open(0, 90);
+
+ModelProps read_model_props(JsonObject& p, const std::string& model, int dim) {
+  if (model == "linear") {
+    LinearProps lp = read_linear_props(p, true);
+    p.finish();
+    return lp;
+  }
+  if (model == "linearpbond") {
+    PBondProps pb;
+    pb.linear = read_linear_props(p, false);
+    pb.pb_rmul = p.number("pb_rmul", Range::positive(), 1.0);
+    const bool deform = p.has("pb_emod");
+    if (deform && (p.has("pb_kn") || p.has("pb_ks")))
+      p.fail("pb_emod", "give either pb_kn/pb_ks or pb_emod/pb_kratio, not both");
+    if (deform) {
+      pb.pb_emod = p.number("pb_emod", Range::positive(), std::nullopt, "Pa");
+      pb.pb_kratio = p.number("pb_kratio", Range::non_negative(), 0.0);
+    } else {
+      pb.pb_kn = p.number("pb_kn", Range::non_negative(), 0.0, "Pa/m");
+      pb.pb_ks = p.number("pb_ks", Range::non_negative(), 0.0, "Pa/m");
+    }
+    pb.pb_mcf = p.number("pb_mcf", Range::closed(0, 1), 1.0);
+    pb.pb_ten = p.number("pb_ten", Range::non_negative(), 0.0, "Pa");
+    pb.pb_coh = p.number("pb_coh", Range::non_negative(), 0.0, "Pa");
+    pb.pb_fa = p.number("pb_fa", kAngle, 0.0, "deg");
+    read_bond(p, true, pb.bond, pb.bond_gap_lo, pb.bond_gap_hi);
+    p.finish();
+    return pb;
+  }
+  if (model == "flatjoint") {
+    FlatJointProps fj;
+    fj.fj_Nr = static_cast<int>(p.integer("fj_Nr", 1, 1000, 2));
+    fj.fj_Nal = static_cast<int>(p.integer("fj_Nal", 3, 1000, 4));
+    if (dim == 2 && p.has("fj_Nal"))
+      p.fail("fj_Nal", "is a 3D property (2D flat joints have fj_Nr elements only)");
+    fj.fj_rmul = p.number("fj_rmul", Range::positive(), 1.0);
+    fj.fj_gap0 = p.number("fj_gap0", Range::non_negative(), 0.0, "m");
+    const bool deform = p.has("fj_emod");
+    if (deform && (p.has("fj_kn") || p.has("fj_ks")))
+      p.fail("fj_emod", "give either fj_kn/fj_ks or fj_emod/fj_kratio, not both");
+    if (deform) {
+      fj.fj_emod = p.number("fj_emod", Range::positive(), std::nullopt, "Pa");
+      fj.fj_kratio = p.number("fj_kratio", Range::non_negative(), 0.0);
+    } else {
+      fj.fj_kn = p.number("fj_kn", Range::non_negative(), 0.0, "Pa/m");
+      fj.fj_ks = p.number("fj_ks", Range::non_negative(), 0.0, "Pa/m");
+    }
+    fj.fj_fric = p.number("fj_fric", Range::non_negative(), 0.0);
+    fj.fj_ten = p.number("fj_ten", Range::non_negative(), 0.0, "Pa");
+    fj.fj_coh = p.number("fj_coh", Range::non_negative(), 0.0, "Pa");
+    fj.fj_fa = p.number("fj_fa", kAngle, 0.0, "deg");
+    fj.fj_exact = p.boolean("fj_exact", false);
+    if (dim == 2 && fj.fj_exact)
+      p.fail("fj_exact", "is a 3D option (the 2D element integrals are always exact)");
+    double lo, hi;
+    read_bond(p, false, fj.bond, lo, hi);
+    if (fj.bond && fj.fj_gap0 > 0)
+      p.fail("bond", "only elements with a zero gap can be bonded, but fj_gap0 > 0");
+    p.finish();
+    return fj;
+  }
+  SmoothJointProps sj;
+  sj.sj_kn = p.number("sj_kn", Range::non_negative(), 0.0, "Pa/m");
+  sj.sj_ks = p.number("sj_ks", Range::non_negative(), 0.0, "Pa/m");
+  sj.sj_fric = p.number("sj_fric", Range::non_negative(), 0.0);
+  sj.sj_da = p.number("sj_da", kAngle, 0.0, "deg");
+  sj.sj_ten = p.number("sj_ten", Range::non_negative(), 0.0, "Pa");
+  sj.sj_coh = p.number("sj_coh", Range::non_negative(), 0.0, "Pa");
+  sj.sj_fa = p.number("sj_fa", kAngle, 0.0, "deg");
+  sj.sj_rmul = p.number("sj_rmul", Range::positive(), 1.0);
+  sj.sj_large = p.boolean("sj_large", false);
+  sj.dip = p.number("dip", Range::closed(0, 360), 0.0, "deg");
+  sj.ddir = p.number("ddir", Range::closed(0, 360), 0.0, "deg");
+  if (dim == 2 && p.has("ddir"))
+    p.fail("ddir", "is a 3D property");
+  read_bond(p, false, sj.bond, sj.bond_gap_lo, sj.bond_gap_hi);
+  p.finish();
+  return sj;
 }
 
 void read_contact_models(JsonObject& top, Model& m) {
@@ -332,10 +443,12 @@ void read_contact_models(JsonObject& top, Model& m) {
         o.fail("wall", "no wall is named \"" + wname + "\"");
       rule.wall = found;
     }
-    const std::string model = o.choice("model", {"linear"});
+    const std::string model =
+        o.choice("model", {"linear", "linearpbond", "flatjoint", "smoothjoint"});
+    if (model == "smoothjoint" && rule.ball_facet)
+      o.fail("model", "the smooth-joint model is installed at ball-ball contacts only");
     JsonObject props = o.object("properties");
-    if (model == "linear")
-      rule.props = read_linear_props(props);
+    rule.props = read_model_props(props, model, m.settings.dim);
     o.finish();
     m.rules.push_back(rule);
   }
@@ -484,17 +597,46 @@ Scene load_scene(const std::string& path) {
   read_balls(top, m);
   read_contact_models(top, m);
 
-  JsonObject run = top.object("run");
-  s.run.cycles = run.integer("cycles", 1, std::numeric_limits<std::int64_t>::max(), 0);
-  s.run.time = run.number("time", Range::positive(), 0.0, "s");
-  s.run.ratio = run.number("unbalanced_force_ratio", Range::positive(), 0.0);
-  s.run.max_cycles = run.integer("max_cycles", 1, std::numeric_limits<std::int64_t>::max(), 0);
-  s.run.check_every = run.integer("check_every", 1, 1'000'000, 10);
-  run.finish();
-  const int stops = (s.run.cycles > 0) + (s.run.time > 0) + (s.run.ratio > 0);
-  if (stops != 1)
-    throw InputError(path + ": key 'run': give exactly one of 'cycles', 'time' or "
-                            "'unbalanced_force_ratio'");
+  std::vector<std::pair<const nlohmann::json*, std::string>> stages;
+  if (top.has("run") && top.raw("run").is_array())
+    stages = top.array("run");
+  else
+    stages.emplace_back(&top.raw("run"), "run");
+  if (stages.empty())
+    top.fail("run", "give at least one stage");
+  for (const auto& [js, spath] : stages) {
+    JsonObject run(*js, path, spath);
+    Stage st;
+    st.run.cycles = run.integer("cycles", 1, std::numeric_limits<std::int64_t>::max(), 0);
+    st.run.time = run.number("time", Range::positive(), 0.0, "s");
+    st.run.ratio = run.number("unbalanced_force_ratio", Range::positive(), 0.0);
+    st.run.max_cycles = run.integer("max_cycles", 1, std::numeric_limits<std::int64_t>::max(), 0);
+    st.run.check_every = run.integer("check_every", 1, 1'000'000, 10);
+    for (const auto& [jc, cpath] : run.array("set", false)) {
+      JsonObject ch(*jc, path, cpath);
+      BallChange bc;
+      const std::int64_t id = ch.integer("ball", 0, std::numeric_limits<std::int32_t>::max());
+      auto it = std::find(m.balls.id.begin(), m.balls.id.end(), id);
+      if (it == m.balls.id.end())
+        ch.fail("ball", "no ball has id " + std::to_string(id));
+      bc.index = static_cast<std::size_t>(it - m.balls.id.begin());
+      if (ch.has("velocity"))
+        bc.velocity = ch.vec("velocity", dim);
+      if (ch.has("spin"))
+        bc.spin = dim == 2 ? Vec3(0, 0, ch.number("spin", Range::any(), std::nullopt, "rad/s"))
+                           : ch.vec("spin", dim);
+      bc.fix = parse_fixity(ch, dim);
+      bc.free = parse_dofs(ch, "free", dim);
+      ch.finish();
+      st.set.push_back(bc);
+    }
+    run.finish();
+    const int stops = (st.run.cycles > 0) + (st.run.time > 0) + (st.run.ratio > 0);
+    if (stops != 1)
+      throw InputError(path + ": key '" + spath +
+                       "': give exactly one of 'cycles', 'time' or 'unbalanced_force_ratio'");
+    s.stages.push_back(st);
+  }
   read_history(top, s);
   top.finish();
   return s;

@@ -5,6 +5,7 @@
 #include "io/json_input.hpp"
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,11 +41,26 @@ struct HistoryColumn {
   int component = 0;     ///< 0..2 = x..z, 3 = magnitude
 };
 
+/// A change to one ball at the start of a stage.
+struct BallChange {
+  std::size_t index = 0;
+  std::optional<Vec3> velocity, spin;
+  std::uint8_t fix = 0;  ///< DOFs to fix
+  std::uint8_t free = 0; ///< DOFs to free
+};
+
+/// One stage of a run: changes applied at its start, then cycles until its stop rule. Cycle and
+/// time limits count from the start of the stage.
+struct Stage {
+  RunSpec run;
+  std::vector<BallChange> set;
+};
+
 struct Scene {
   std::string file;
   std::string description;
   std::unique_ptr<Model> model;
-  RunSpec run;
+  std::vector<Stage> stages;
   std::int64_t history_every = 0;
   std::vector<HistoryColumn> history;
 };

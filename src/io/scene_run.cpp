@@ -29,43 +29,58 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
     history += history_row(m, scene.history, summary.events);
   }
 
-  const RunSpec& run = scene.run;
-  auto done = [&]() {
-    if (run.cycles > 0)
-      return m.step() >= run.cycles;
-    if (run.max_cycles > 0 && m.step() >= run.max_cycles)
-      return true;
-    if (run.time > 0)
-      return m.time() >= run.time;
-    if (m.step() % run.check_every != 0)
-      return false;
-    return m.mean_unbalanced_force_ratio() < run.ratio;
-  };
-  while (!done()) {
-    if (opts.interrupt && opts.interrupt->load())
-      throw std::runtime_error("interrupted; nothing was written to " + opts.out_dir);
-    m.cycle(1);
-    events.clear();
-    m.drain_events(events);
-    summary.events.add(events);
-    if (want_history && m.step() % scene.history_every == 0)
-      history += history_row(m, scene.history, summary.events);
-    if (opts.progress) {
-      const auto now = clock::now();
-      if (now - t0 > std::chrono::seconds(2) && now - last_print > std::chrono::milliseconds(500)) {
-        last_print = now;
-        double frac = -1;
-        if (run.cycles > 0)
-          frac = static_cast<double>(m.step()) / static_cast<double>(run.cycles);
-        else if (run.time > 0)
-          frac = m.time() / run.time;
-        if (frac >= 0)
-          std::fprintf(stderr, "\r[rocklab] step %lld  t = %.4g s  %5.1f%%   ",
-                       static_cast<long long>(m.step()), m.time(), 100.0 * frac);
-        else
-          std::fprintf(stderr, "\r[rocklab] step %lld  t = %.4g s  ratio %.3g   ",
-                       static_cast<long long>(m.step()), m.time(), m.mean_unbalanced_force_ratio());
-        std::fflush(stderr);
+  for (const Stage& stage : scene.stages) {
+    for (const BallChange& bc : stage.set) {
+      if (bc.velocity)
+        m.balls.vel[bc.index] = *bc.velocity;
+      if (bc.spin)
+        m.balls.spin[bc.index] = *bc.spin;
+      m.balls.fixity[bc.index] =
+          static_cast<std::uint8_t>((m.balls.fixity[bc.index] | bc.fix) & ~bc.free);
+    }
+    const RunSpec& run = stage.run;
+    const std::int64_t step0 = m.step();
+    const double time0 = m.time();
+    auto done = [&]() {
+      const std::int64_t steps = m.step() - step0;
+      if (run.cycles > 0)
+        return steps >= run.cycles;
+      if (run.max_cycles > 0 && steps >= run.max_cycles)
+        return true;
+      if (run.time > 0)
+        return m.time() - time0 >= run.time;
+      if (steps % run.check_every != 0)
+        return false;
+      return m.mean_unbalanced_force_ratio() < run.ratio;
+    };
+    while (!done()) {
+      if (opts.interrupt && opts.interrupt->load())
+        throw std::runtime_error("interrupted; nothing was written to " + opts.out_dir);
+      m.cycle(1);
+      events.clear();
+      m.drain_events(events);
+      summary.events.add(events);
+      if (want_history && m.step() % scene.history_every == 0)
+        history += history_row(m, scene.history, summary.events);
+      if (opts.progress) {
+        const auto now = clock::now();
+        if (now - t0 > std::chrono::seconds(2) &&
+            now - last_print > std::chrono::milliseconds(500)) {
+          last_print = now;
+          double frac = -1;
+          if (run.cycles > 0)
+            frac = static_cast<double>(m.step() - step0) / static_cast<double>(run.cycles);
+          else if (run.time > 0)
+            frac = (m.time() - time0) / run.time;
+          if (frac >= 0)
+            std::fprintf(stderr, "\r[rocklab] step %lld  t = %.4g s  %5.1f%%   ",
+                         static_cast<long long>(m.step()), m.time(), 100.0 * frac);
+          else
+            std::fprintf(stderr, "\r[rocklab] step %lld  t = %.4g s  ratio %.3g   ",
+                         static_cast<long long>(m.step()), m.time(),
+                         m.mean_unbalanced_force_ratio());
+          std::fflush(stderr);
+        }
       }
     }
   }

@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""Writes the two-grain verification scenes of the flat-joint memo, section 2.1 (units: SI).
+
+Two granite grains (E = 29 GPa, nu = 0.15, rho = 2650 kg/m^3, R = 6.25 mm so that
+lambda = 0.8 gives a 5 mm bond/joint radius) touch along y. Both are fixed and moved:
+axial: grain 2 moves +y by 1 mm; twist (3D): grain 2 turns 0.2 rad about y;
+bend: the grains turn by -+0.2 rad about the t axis (3D: t = -z; 2D: about z, so that the
+relative bend rotation theta_bs = +0.4 rad). 1000 steps of 1 us.
+"""
+import json, os
+
+E, NU, L = 29e9, 0.15, 12.5e-3
+KN, KS = E / L, E / (2 * (1 + NU) * L)
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def scene(dim, model, props, case, tag):
+    R = 6.25e-3
+    v2, w1, w2 = [0, 0, 0], [0, 0, 0], [0, 0, 0]
+    if case == "axial":
+        v2 = [0, 1.0, 0]
+    elif case == "twist":
+        w2 = [0, 200.0, 0]
+    else:  # bend
+        if dim == 3:
+            w1, w2 = [0, 0, 200.0], [0, 0, -200.0]  # about t = -z: theta_bt = +0.4
+        else:
+            w1, w2 = [0, 0, 200.0], [0, 0, -200.0]  # theta_z = -0.4: theta_bs = +0.4
+    def ball(i, pos, v, w):
+        b = {"id": i, "position": pos[:dim], "radius": R, "density": 2650,
+             "velocity": v[:dim], "fix": "all"}
+        b["spin"] = w[2] if dim == 2 else w
+        return b
+    return {
+        "description": f"Memo 2.1 two-grain test, {model} {dim}D, {case} ({tag}). Units: SI.",
+        "dimension": dim,
+        "local_damping": 0.7,
+        "timestep": 1e-6,
+        "balls": [ball(1, [0, 0, 0], [0, 0, 0], w1), ball(2, [0, 2 * R, 0], v2, w2)],
+        "contact_models": [{"between": "ball-ball", "model": model, "properties": props}],
+        "run": {"cycles": 1000},
+    }
+
+
+def pb():
+    return {"kn": 0, "ks": 0, "pb_rmul": 0.8, "pb_mcf": 1.0, "pb_kn": KN, "pb_ks": KS,
+            "pb_ten": 1e20, "pb_coh": 1e20, "pb_fa": 0, "bond": True}
+
+
+def fj(dim, nr, nal=None, exact=False):
+    p = {"fj_Nr": nr, "fj_rmul": 0.8, "fj_gap0": 0, "fj_kn": KN, "fj_ks": KS, "fj_fric": 0,
+         "fj_ten": 1e20, "fj_coh": 1e20, "fj_fa": 0, "bond": True}
+    if dim == 3:
+        p["fj_Nal"] = nal
+    if exact:
+        p["fj_exact"] = True
+    return p
+
+
+def write(name, data):
+    with open(os.path.join(HERE, name + ".json"), "w") as f:
+        json.dump(data, f, indent=1)
+        f.write("\n")
+
+
+for case in ("axial", "twist", "bend"):
+    write(f"two_grain_pb_3d_{case}", scene(3, "linearpbond", pb(), case, "parallel bond"))
+    for nr, nal in ((2, 8), (3, 16), (4, 24)):
+        write(f"two_grain_fj_3d_{case}_{nr}x{nal}",
+              scene(3, "flatjoint", fj(3, nr, nal), case, f"Nr={nr}, Nal={nal}"))
+        write(f"two_grain_fjexact_3d_{case}_{nr}x{nal}",
+              scene(3, "flatjoint", fj(3, nr, nal, True), case, f"exact, Nr={nr}, Nal={nal}"))
+for case in ("axial", "bend"):
+    write(f"two_grain_pb_2d_{case}", scene(2, "linearpbond", pb(), case, "parallel bond"))
+    write(f"two_grain_fj_2d_{case}", scene(2, "flatjoint", fj(2, 4), case, "Nr=4"))
