@@ -84,3 +84,58 @@ inline int run_command(const std::string& cmd, std::string* output = nullptr) {
 }
 
 } // namespace rocklab::test
+
+#include "io/scene.hpp"
+
+namespace rocklab::test {
+
+/// |a - b| within half a unit of the 4th significant digit of b ("to 4 significant digits").
+inline ::testing::AssertionResult four_digits(double a, double b) {
+  const double unit = std::pow(10.0, std::floor(std::log10(std::abs(b))) - 3);
+  if (std::abs(a - b) <= 0.5 * unit)
+    return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << a << " does not match " << b << " to 4 digits";
+}
+
+/// Rotate (and shift) a loaded scene's bodies: positions, velocities, spins, walls, gravity.
+inline void transform_model(Model& m, const Eigen::Matrix3d& R, const Vec3& shift) {
+  for (std::size_t i = 0; i < m.balls.size(); ++i) {
+    m.balls.pos[i] = R * m.balls.pos[i] + shift;
+    m.balls.vel[i] = R * m.balls.vel[i];
+    m.balls.spin[i] = R * m.balls.spin[i];
+  }
+  for (Wall& w : m.walls) {
+    for (Facet& f : w.facets)
+      for (int k = 0; k < f.nv; ++k)
+        f.v[k] = R * f.v[k] + shift;
+    w.center = R * w.center + shift;
+    w.velocity = R * w.velocity;
+    w.spin = R * w.spin;
+    w.update_bounds();
+  }
+  m.settings.gravity = R * m.settings.gravity;
+}
+
+/// Run every stage of a scene (cycle-count stages) without writing output; returns the model.
+inline std::unique_ptr<Model> run_scene_file(const std::string& file,
+                                             const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity(),
+                                             const Vec3& shift = Vec3::Zero()) {
+  Scene s = load_scene(file);
+  transform_model(*s.model, R, shift);
+  s.model->initialize();
+  for (const Stage& st : s.stages) {
+    for (const BallChange& bc : st.set) {
+      if (bc.velocity)
+        s.model->balls.vel[bc.index] = R * *bc.velocity;
+      if (bc.spin)
+        s.model->balls.spin[bc.index] = R * *bc.spin;
+      s.model->balls.fixity[bc.index] =
+          static_cast<std::uint8_t>((s.model->balls.fixity[bc.index] | bc.fix) & ~bc.free);
+    }
+    EXPECT_GT(st.run.cycles, 0) << "test helper runs cycle-count stages only";
+    s.model->cycle(st.run.cycles);
+  }
+  return std::move(s.model);
+}
+
+} // namespace rocklab::test

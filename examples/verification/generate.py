@@ -44,7 +44,9 @@ def scene(dim, model, props, case, tag):
 
 def pb():
     return {"kn": 0, "ks": 0, "pb_rmul": 0.8, "pb_mcf": 1.0, "pb_kn": KN, "pb_ks": KS,
-            "pb_ten": 1e20, "pb_coh": 1e20, "pb_fa": 0, "bond": True}
+            "pb_ten": 1e20, "pb_coh": 1e20, "pb_fa": 0,
+            # bond pieces up to 1 nm apart: "just touching" is exact only up to round-off
+            "bond": 1e-9}
 
 
 def fj(dim, nr, nal=None, exact=False):
