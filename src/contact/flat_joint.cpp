@@ -201,26 +201,38 @@ Moments clipped_moments(double r1, double r2, double a1, double a2, double gs, d
   return m;
 }
 
-double element_strain_energy(const FlatJointContact& c, const FlatJointElement& el, double A,
-                             int dim) {
-  // Eq. 37
-  double I, J;
-  if (dim == 2) {
-    const double rbar = c.R / c.geo->Nr;
-    I = 2.0 / 3.0 * rbar * rbar * rbar;
-    J = 0;
-  } else {
-    const double re2 = A / kPi;
-    I = 0.25 * kPi * re2 * re2;
-    J = 0.5 * kPi * re2 * re2;
-  }
+double element_strain_energy(const FlatJointContact& c, const FlatJointElement& el, std::size_t i,
+                             double A, int dim) {
   double e = 0;
   if (c.kn > 0)
-    e += el.Fn * el.Fn / (c.kn * A) + (el.Mbs * el.Mbs + el.Mbt * el.Mbt) / (c.kn * I);
-  if (c.ks > 0) {
+    e += el.Fn * el.Fn / (c.kn * A);
+  if (c.ks > 0)
     e += (el.Fss * el.Fss + el.Fst * el.Fst) / (c.ks * A);
-    if (J > 0)
-      e += el.Mt * el.Mt / (c.ks * J);
+  if (dim == 2) { // Eq. 37, exact in 2D
+    const double rbar = c.R / c.geo->Nr;
+    if (c.kn > 0)
+      e += el.Mbs * el.Mbs / (c.kn * 2.0 / 3.0 * rbar * rbar * rbar);
+  } else if (!c.exact) {
+    // Eq. 37 in 3D: the element taken as a disk of equal area.
+    const double re2 = A / kPi;
+    if (c.kn > 0)
+      e += (el.Mbs * el.Mbs + el.Mbt * el.Mbt) / (c.kn * 0.25 * kPi * re2 * re2);
+    if (c.ks > 0)
+      e += el.Mt * el.Mt / (c.ks * 0.5 * kPi * re2 * re2);
+  } else {
+    // Exact elements carry the moments of the sector's true stress field, so their energy
+    // uses the sector's own centroidal second moments: E = m^T I^-1 m / (2 kn), m = (Mt, -Ms).
+    const FlatJointGeometry& g = *c.geo;
+    const double R4 = std::pow(c.R, 4), se = g.s[i] * c.R, te = g.t[i] * c.R;
+    const double Iss = g.Ixx[i] * R4 - A * se * se, Ist = g.Ixy[i] * R4 - A * se * te,
+                 Itt = g.Iyy[i] * R4 - A * te * te;
+    const double det = Iss * Itt - Ist * Ist;
+    const double m1 = el.Mbt, m2 = -el.Mbs;
+    if (c.kn > 0 && det > 0)
+      e += (Itt * m1 * m1 - 2 * Ist * m1 * m2 + Iss * m2 * m2) / det / c.kn;
+    const double Jc = g.Jp[i] * R4 - A * (se * se + te * te);
+    if (c.ks > 0 && Jc > 0)
+      e += el.Mt * el.Mt / (c.ks * Jc);
   }
   return 0.5 * e;
 }
@@ -411,7 +423,7 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
       events.raise(ev);
     };
     if (bonded && sigma > c.ten) { // tensile break
-      const double energy = element_strain_energy(c, el, A, dim);
+      const double energy = element_strain_energy(c, el, i, A, dim);
       el.B = 1;
       el.Fn = el.Fss = el.Fst = el.Mt = 0;
       raise_break(1, c.ten, energy);
@@ -442,7 +454,12 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
         const double scale = tau > 0 ? tau_c / tau : 0.0;
         Fss *= scale;
         Fst *= scale;
-        el.E_slip += tau_c * A * std::sqrt(dss * dss + dst * dst); // Eq. 39
+        // Eq. 39 with the slip part of the increment only (the part not taken up elastically,
+        // -(F - F0) / (ks A)); in steady sliding the two agree, and in the step where slip
+        // starts this keeps the slip energy equal to the friction work.
+        const double ess = dss + (Fss - el.Fss) / (c.ks * A);
+        const double est = dst + (Fst - el.Fst) / (c.ks * A);
+        el.E_slip += tau_c * A * std::sqrt(ess * ess + est * est);
         el.Mt = 0;
       } else if (c.exact) {
         el.Mt -= c.ks * alpha * k.d_tt * (geo.Jp[i] * R * R * R * R - A * (se * se + te * te));
@@ -460,7 +477,7 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
     } else {
       const double tau_c = c.coh - sigma * c.tan_fa;
       if (tau > tau_c) { // shear break
-        const double energy = element_strain_energy(c, el, A, dim);
+        const double energy = element_strain_energy(c, el, i, A, dim);
         el.B = 2;
         el.Fss = el.Fst = el.Mt = 0;
         normal_update(false); // re-evaluate as unbonded
@@ -504,8 +521,8 @@ ContactEnergy energy(const FlatJointContact& c, std::span<const FlatJointElement
   const int dim = c.geo->dim;
   for (std::size_t i = 0; i < e.size(); ++i) {
     const double A = c.geo->A[i] * (dim == 2 ? c.R : c.R * c.R);
-    out.strain += element_strain_energy(c, e[i], A, dim); // Eq. 36
-    out.slip += e[i].E_slip;                              // Eq. 38
+    out.strain += element_strain_energy(c, e[i], i, A, dim); // Eq. 36
+    out.slip += e[i].E_slip;                                 // Eq. 38
   }
   return out;
 }
