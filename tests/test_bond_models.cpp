@@ -173,9 +173,11 @@ TEST(FlatJointBreakage, PartiallyBrokenJointCarriesOnlyCompressionAndFrictionWhe
   // Opening again: the broken elements carry no tension.
   for (int i = 0; i < 400; ++i)
     d.step(1e-8);
-  for (const auto& e : els)
-    if (e.B != 3)
+  for (const auto& e : els) {
+    if (e.B != 3) {
       EXPECT_LE(e.Fn, 0.0);
+    }
+  }
 }
 
 namespace {
