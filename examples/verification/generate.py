@@ -75,3 +75,38 @@ for case in ("axial", "twist", "bend"):
 for case in ("axial", "bend"):
     write(f"two_grain_pb_2d_{case}", scene(2, "linearpbond", pb(), case, "parallel bond"))
     write(f"two_grain_fj_2d_{case}", scene(2, "flatjoint", fj(2, 4), case, "Nr=4"))
+
+
+def interlocked(dim, exact=False):
+    """Memo 2.2: a central grain and four neighbours (+-x, +-y), unbonded frictionless flat
+    joints. Stage 1 turns the central grain by 0.01 rad about z with everything fixed; stage 2
+    stops it and frees the neighbours' rotations (local damping 0.7)."""
+    R = 6.25e-3
+    props = fj(dim, 4 if dim == 2 else 2, 8 if dim == 3 else None, exact)
+    props.update({"bond": False, "fj_ten": 0, "fj_coh": 0})
+    def ball(i, x, y):
+        return {"id": i, "position": [x, y] if dim == 2 else [x, y, 0], "radius": R,
+                "density": 2650, "fix": "all"}
+    spin = 10.0 if dim == 2 else [0, 0, 10.0]
+    still = 0.0 if dim == 2 else [0, 0, 0]
+    free = ["rz"] if dim == 2 else ["rx", "ry", "rz"]
+    return {
+        "description": f"Memo 2.2 interlocked grain, {dim}D{' exact' if exact else ''}: turn the "
+                       "centre, then release the neighbours' rotations. Units: SI.",
+        "dimension": dim,
+        "local_damping": 0.7,
+        "timestep": 1e-6,
+        "balls": [ball(1, 0, 0), ball(2, 2 * R, 0), ball(3, 0, 2 * R), ball(4, -2 * R, 0),
+                  ball(5, 0, -2 * R)],
+        "contact_models": [{"between": "ball-ball", "model": "flatjoint", "properties": props}],
+        "run": [
+            {"cycles": 1000, "set": [{"ball": 1, "spin": spin}]},
+            {"cycles": 20000, "set": [{"ball": 1, "spin": still}] +
+                                     [{"ball": i, "free": free} for i in (2, 3, 4, 5)]},
+        ],
+    }
+
+
+write("interlocked_2d", interlocked(2))
+write("interlocked_3d", interlocked(3))
+write("interlocked_3d_exact", interlocked(3, True))

@@ -62,8 +62,7 @@ FlatJointGeometry build_geometry(int dim, int Nr, int Nal) {
   return g;
 }
 
-// Integrals of 1, s, t, s^2, s t, t^2 over a region.
-using Moments = std::array<double, 6>;
+using Moments = flatjoint::Moments;
 
 // Green's theorem: int int f dA = closed-line integral of F dt with dF/ds = f, for
 // F = s, s^2/2, s t, s^3/3, s^2 t/2, s t^2. Straight segment, exact with 2-point Gauss (cubic).
@@ -104,9 +103,11 @@ void add_arc(double rho, double a, double b, Moments& m) {
   m[5] += r4 * (pb[5] - pa[5]);
 }
 
+} // namespace
+
 // Moments of {p in sector : gs + p . b < 0} (the compressed part of an unbonded element).
-Moments clipped_moments(double r1, double r2, double a1, double a2, double gs, double bs,
-                        double bt) {
+flatjoint::Moments flatjoint::clipped_moments(double r1, double r2, double a1, double a2, double gs,
+                                              double bs, double bt) {
   Moments m{};
   const double bn = std::hypot(bs, bt);
   auto inside = [&](double s, double t) { return gs + s * bs + t * bt < 0; };
@@ -200,6 +201,8 @@ Moments clipped_moments(double r1, double r2, double a1, double a2, double gs, d
   (void)inside;
   return m;
 }
+
+namespace {
 
 double element_strain_energy(const FlatJointContact& c, const FlatJointElement& el, std::size_t i,
                              double A, int dim) {
@@ -386,7 +389,8 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
           m = {geo.A[i] * R2,   geo.s[i] * geo.A[i] * R3, geo.t[i] * geo.A[i] * R3,
                geo.Ixx[i] * R4, geo.Ixy[i] * R4,          geo.Iyy[i] * R4};
         } else {
-          m = clipped_moments(geo.r1[i] * R, geo.r2[i] * R, geo.a1[i], geo.a2[i], c.gs, bs, bt);
+          m = flatjoint::clipped_moments(geo.r1[i] * R, geo.r2[i] * R, geo.a1[i], geo.a2[i], c.gs,
+                                         bs, bt);
         }
         el.Fn = c.kn * (c.gs * m[0] + bs * m[1] + bt * m[2]);
         const double Ms = -c.kn * (c.gs * m[2] + bs * m[4] + bt * m[5]); // -int t sigma

@@ -5,6 +5,7 @@
 
 #include "contact/contact_model.hpp"
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -85,6 +86,13 @@ void unbond(FlatJointContact& c, std::span<FlatJointElement> e);
 inline double gap_at(const FlatJointContact& c, double s, double t) {
   return c.gs + t * c.tbs - s * c.tbt;
 }
+
+/// Integrals of 1, s, t, s^2, s t, t^2 over a region [m^2 .. m^4].
+using Moments = std::array<double, 6>;
+/// Exact moments of the part of the annular sector r1 <= r <= r2, a1 <= alpha <= a2 where the
+/// gap gs + bs s + bt t is negative (Green's theorem: analytic on arcs, exact Gauss on lines).
+Moments clipped_moments(double r1, double r2, double a1, double a2, double gs, double bs,
+                        double bt);
 
 /// 2D element normal force and bending moment from the end gaps (Eq. 44-49), per unit thickness.
 /// Returns Fn (> 0 tension) and Mb (about k).
