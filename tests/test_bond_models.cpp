@@ -407,3 +407,60 @@ TEST(ContactEnergy, SlipEnergyEqualsFrictionWork) {
     EXPECT_TRUE(near_rel(d->work, e.strain + e.slip, 1e-6)) << static_cast<int>(d->kind);
   }
 }
+
+namespace {
+struct Slide {
+  double along;  // displacement of the block along the joint's down-dip direction [m]
+  double across; // displacement normal to the joint [m]
+  std::int64_t breaks;
+};
+Slide slide(const std::string& name, const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity()) {
+  Scene s = load_scene(test::source_dir() + "/examples/verification/" + name + ".json");
+  test::transform_model(*s.model, R, Vec3::Zero());
+  // The joint plane turns with the scene.
+  auto& sj = std::get<SmoothJointProps>(s.model->rules[0].props);
+  const Vec3 nj = R * joint_normal(3, sj.dip, sj.ddir);
+  sj.use_normal = true;
+  sj.normal = nj;
+  Model& m = *s.model;
+  m.initialize();
+  const Vec3 x0 = m.balls.pos[1];
+  m.cycle(s.stages[0].run.cycles);
+  std::vector<Event> ev;
+  m.drain_events(ev);
+  std::int64_t breaks = 0;
+  for (const Event& e : ev)
+    breaks += e.type == EventType::BondBreak;
+  const Vec3 g = m.settings.gravity.normalized();
+  const Vec3 down = (g - g.dot(nj) * nj).normalized();
+  const Vec3 dx = m.balls.pos[1] - x0;
+  return {dx.dot(down), dx.dot(nj), breaks};
+}
+} // namespace
+
+TEST(SmoothJoint, BlockOnAnInclinedJointSlidesAtTheCoulombLimit) {
+  const double th = kPi / 6, T = 0.1; // dip 30 degrees, 50000 steps of 2 us
+  const double a = 9.81 * (std::sin(th) - 0.3 * std::cos(th));
+  const Slide s = slide("smooth_joint_slide");
+  EXPECT_TRUE(near_rel(s.along, 0.5 * a * T * T, 2e-3));
+  EXPECT_LT(std::abs(s.across), 1e-5);
+  // Holding: only the elastic shear displacement, at most twice the static m g sin / (ks A).
+  const double m = 2650 * 4.0 / 3 * kPi * std::pow(6.25e-3, 3);
+  const double elastic = 2 * m * 9.81 * std::sin(th) / (1e9 * kPi * std::pow(6.25e-3, 2));
+  const Slide h = slide("smooth_joint_hold"); // mu = 0.7 > tan 30
+  EXPECT_LT(std::abs(h.along), elastic);
+  const Slide b = slide("smooth_joint_bonded_strong");
+  EXPECT_LT(std::abs(b.along), elastic);
+  EXPECT_EQ(b.breaks, 0);
+  const Slide w = slide("smooth_joint_bonded_weak"); // breaks in shear at once, then slides
+  EXPECT_EQ(w.breaks, 1);
+  EXPECT_TRUE(near_rel(w.along, 0.5 * a * T * T, 5e-3));
+  // Rotated arbitrarily in 3D (with gravity and the joint plane): the same motion.
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(2.3, Vec3(-0.4, 0.7, 0.2).normalized()).toRotationMatrix();
+  const Slide r = slide("smooth_joint_slide", R);
+  EXPECT_TRUE(near_rel(r.along, s.along, 1e-9));
+  const Slide rw = slide("smooth_joint_bonded_weak", R);
+  EXPECT_EQ(rw.breaks, 1);
+  EXPECT_TRUE(near_rel(rw.along, w.along, 1e-9));
+}

@@ -110,3 +110,34 @@ def interlocked(dim, exact=False):
 write("interlocked_2d", interlocked(2))
 write("interlocked_3d", interlocked(3))
 write("interlocked_3d_exact", interlocked(3, True))
+
+
+def joint_slide(mu, coh=None):
+    """A block (ball with fixed rotations) resting on a fixed ball across a smooth joint that
+    dips 30 degrees (dip direction 90: n_j = (0.5, 0, 0.866)); gravity -z. Unbonded with
+    mu = 0.3 < tan 30 it slides with a = g (sin 30 - mu cos 30); with mu = 0.7 it holds."""
+    R = 6.25e-3
+    props = {"sj_kn": 1e9, "sj_ks": 1e9, "sj_fric": mu, "dip": 30, "ddir": 90}
+    if coh is not None:
+        props.update({"bond": 1e-9, "sj_coh": coh, "sj_ten": 1e6})
+    return {
+        "description": f"Smooth-joint block slide, mu = {mu}" + (f", bonded, c = {coh} Pa" if coh else "") + "."
+                       " Units: SI.",
+        "dimension": 3,
+        "gravity": [0, 0, -9.81],
+        "local_damping": 0,
+        "timestep": 2e-6,
+        "balls": [{"id": 1, "position": [0, 0, 0], "radius": R, "density": 2650, "fix": "all"},
+                  {"id": 2, "position": [0, 0, 2 * R], "radius": R, "density": 2650,
+                   "fix": ["rx", "ry", "rz"]}],
+        "contact_models": [{"between": "ball-ball", "model": "smoothjoint", "properties": props}],
+        "run": {"cycles": 50000},
+        "history": {"every": 1000, "columns": ["time", "ball/2/position/x", "ball/2/position/z",
+                                               "energy/slip", "events/slip_change"]},
+    }
+
+
+write("smooth_joint_slide", joint_slide(0.3))
+write("smooth_joint_hold", joint_slide(0.7))
+write("smooth_joint_bonded_strong", joint_slide(0.3, 1e6))
+write("smooth_joint_bonded_weak", joint_slide(0.3, 50.0))

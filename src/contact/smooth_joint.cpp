@@ -34,7 +34,7 @@ SmoothJointContact make(const SmoothJointProps& p, int dim, double R1, double R2
   const double R = c.rmul * std::min(R1, R2); // Eq. 2
   c.A = dim == 2 ? 2 * R : std::numbers::pi * R * R;
   // Piece 2 lies in surface 2 iff n_c . n_j >= 0; orient n_j from piece 1's surface to 2's.
-  const Vec3 nj = joint_normal(dim, p.dip, p.ddir);
+  const Vec3 nj = p.use_normal ? Vec3(p.normal.normalized()) : joint_normal(dim, p.dip, p.ddir);
   c.nj = n_c.dot(nj) >= 0 ? nj : Vec3(-nj);
   if (p.bond)
     bond(c, gap, p.bond_gap_lo, p.bond_gap_hi);

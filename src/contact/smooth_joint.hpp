@@ -10,17 +10,19 @@
 namespace rocklab {
 
 struct SmoothJointProps {
-  double sj_kn = 0;                             ///< normal stiffness per unit area [Pa/m]
-  double sj_ks = 0;                             ///< shear stiffness per unit area [Pa/m]
-  double sj_fric = 0;                           ///< friction coefficient [-]
-  double sj_da = 0;                             ///< dilation angle psi [deg]
-  double sj_ten = 0;                            ///< tensile strength [Pa]
-  double sj_coh = 0;                            ///< cohesion [Pa]
-  double sj_fa = 0;                             ///< friction angle [deg]
-  double sj_rmul = 1.0;                         ///< radius multiplier [-]
-  bool sj_large = false;                        ///< large-strain mode
-  double dip = 0;                               ///< dip theta_p [deg]
-  double ddir = 0;                              ///< dip direction theta_d [deg] (3D)
+  double sj_kn = 0;        ///< normal stiffness per unit area [Pa/m]
+  double sj_ks = 0;        ///< shear stiffness per unit area [Pa/m]
+  double sj_fric = 0;      ///< friction coefficient [-]
+  double sj_da = 0;        ///< dilation angle psi [deg]
+  double sj_ten = 0;       ///< tensile strength [Pa]
+  double sj_coh = 0;       ///< cohesion [Pa]
+  double sj_fa = 0;        ///< friction angle [deg]
+  double sj_rmul = 1.0;    ///< radius multiplier [-]
+  bool sj_large = false;   ///< large-strain mode
+  double dip = 0;          ///< dip theta_p [deg]
+  double ddir = 0;         ///< dip direction theta_d [deg] (3D)
+  bool use_normal = false; ///< give the joint normal directly instead of dip / dip direction
+  Vec3 normal = Vec3::UnitZ();
   bool bond = false;                            ///< apply the bond method at creation
   double bond_gap_lo = -1e300, bond_gap_hi = 0; ///< bond if g_c lies in [lo, hi] [m]
 };

@@ -402,10 +402,19 @@ ModelProps read_model_props(JsonObject& p, const std::string& model, int dim) {
   sj.sj_fa = p.number("sj_fa", kAngle, 0.0, "deg");
   sj.sj_rmul = p.number("sj_rmul", Range::positive(), 1.0);
   sj.sj_large = p.boolean("sj_large", false);
-  sj.dip = p.number("dip", Range::closed(0, 360), 0.0, "deg");
-  sj.ddir = p.number("ddir", Range::closed(0, 360), 0.0, "deg");
-  if (dim == 2 && p.has("ddir"))
-    p.fail("ddir", "is a 3D property");
+  if (p.has("normal")) {
+    if (p.has("dip") || p.has("ddir"))
+      p.fail("normal", "give either the joint normal or dip / ddir, not both");
+    sj.use_normal = true;
+    sj.normal = p.vec("normal", dim);
+    if (sj.normal.norm() == 0)
+      p.fail("normal", "the joint normal must not be the zero vector");
+  } else {
+    sj.dip = p.number("dip", Range::closed(0, 360), 0.0, "deg");
+    sj.ddir = p.number("ddir", Range::closed(0, 360), 0.0, "deg");
+    if (dim == 2 && p.has("ddir"))
+      p.fail("ddir", "is a 3D property");
+  }
   read_bond(p, false, sj.bond, sj.bond_gap_lo, sj.bond_gap_hi);
   p.finish();
   return sj;
