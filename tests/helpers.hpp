@@ -132,6 +132,8 @@ inline std::unique_ptr<Model> run_scene_file(const std::string& file,
       s.model->balls.fixity[bc.index] =
           static_cast<std::uint8_t>((s.model->balls.fixity[bc.index] | bc.fix) & ~bc.free);
     }
+    for (const MethodCall& mc : st.methods)
+      s.model->apply_method(mc.model, mc.method, mc.gap_lo, mc.gap_hi, mc.element);
     EXPECT_GT(st.run.cycles, 0) << "test helper runs cycle-count stages only";
     s.model->cycle(st.run.cycles);
   }

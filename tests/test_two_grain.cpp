@@ -153,3 +153,27 @@ TEST(TwoGrain, RotatedPairGivesTheSameMagnitudes) {
     EXPECT_TRUE(near_rel(b.Mbs, a.Mbs, 1e-9, 1.0)) << name;
   }
 }
+
+TEST(ContactMethods, UnbondThenBondAgainInStages) {
+  Scene s = load_scene(scene("methods_bond_unbond"));
+  Model& m = *s.model;
+  m.initialize();
+  m.cycle(s.stages[0].run.cycles);
+  const double f1 = local_components(m.contacts()[0], m.contact_outputs()[0]).Fn;
+  EXPECT_TRUE(near_rel(f1, axial(3) / 2, 1e-9)); // 0.5 mm
+  for (int k = 1; k < 3; ++k) {
+    for (const MethodCall& mc : s.stages[k].methods)
+      EXPECT_EQ(m.apply_method(mc.model, mc.method, mc.gap_lo, mc.gap_hi, mc.element), 1u);
+    if (k == 1) {
+      m.cycle(1);
+      EXPECT_EQ(m.batches().pbond[0].s.state, 0);
+      EXPECT_EQ(local_components(m.contacts()[0], m.contact_outputs()[0]).Fn, 0.0);
+    } else {
+      m.cycle(s.stages[k].run.cycles);
+      // Bonded again at a 0.501 mm gap: the new bond carries only the last 0.5 mm.
+      EXPECT_EQ(m.batches().pbond[0].s.state, 3);
+      EXPECT_TRUE(near_rel(local_components(m.contacts()[0], m.contact_outputs()[0]).Fn,
+                           axial(3) / 2, 1e-9));
+    }
+  }
+}

@@ -307,11 +307,11 @@ FlatJointContact make(const FlatJointProps& p, int dim, double R1, double R2, bo
   return c;
 }
 
-void bond(FlatJointContact& c, std::span<FlatJointElement> e) {
+void bond(FlatJointContact& c, std::span<FlatJointElement> e, std::size_t first) {
   // Only elements with a zero gap over their whole surface can be bonded.
   const double tb = std::hypot(c.tbs, c.tbt);
   for (std::size_t i = 0; i < e.size(); ++i) {
-    const double s = c.geo->s[i] * c.R, t = c.geo->t[i] * c.R;
+    const double s = c.geo->s[first + i] * c.R, t = c.geo->t[first + i] * c.R;
     if (gap_at(c, s, t) == 0 && tb == 0)
       e[i].B = 3;
   }

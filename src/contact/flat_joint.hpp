@@ -78,8 +78,9 @@ ContactEnergy energy(const FlatJointContact& c, std::span<const FlatJointElement
 /// Active if any element is bonded or the interface gap is negative somewhere (section 1.6);
 /// may be deleted once the notional surfaces are a flat-joint diameter apart.
 bool keeps_alive(const FlatJointContact& c, std::span<const FlatJointElement> e);
-/// The bond method: bond every element whose gap is zero over its whole surface.
-void bond(FlatJointContact& c, std::span<FlatJointElement> e);
+/// The bond method: bond every element whose gap is zero over its whole surface (`first` is the
+/// index of e[0] among the contact's elements).
+void bond(FlatJointContact& c, std::span<FlatJointElement> e, std::size_t first = 0);
 void unbond(FlatJointContact& c, std::span<FlatJointElement> e);
 
 /// Gap at a point (s, t) of the interface (Eq. 14, 21).

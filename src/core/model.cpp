@@ -690,6 +690,55 @@ void Model::drain_events(std::vector<Event>& out) {
   pending_events_.clear();
 }
 
+std::size_t Model::apply_method(ModelKind kind, const std::string& method, double gap_lo,
+                                double gap_hi, int element) {
+  std::size_t count = 0;
+  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+    Contact& c = contacts_[ci];
+    if (c.model != kind)
+      continue;
+    ++count;
+    const double gap = c.gap;
+    switch (kind) {
+    case ModelKind::PBond:
+      if (method == "bond")
+        pbond::bond(batches_.pbond[c.slot], gap, gap_lo, gap_hi);
+      else
+        pbond::unbond(batches_.pbond[c.slot], gap, gap_lo, gap_hi);
+      break;
+    case ModelKind::FlatJoint: {
+      FlatJointContact& fj = batches_.flatjoint[c.slot];
+      auto els = batches_.elements(fj);
+      if (element > static_cast<int>(els.size()))
+        throw std::invalid_argument("flat-joint method '" + method + "': element " +
+                                    std::to_string(element) + " is out of range [1, " +
+                                    std::to_string(els.size()) + "]");
+      const auto part = element > 0 ? els.subspan(static_cast<std::size_t>(element - 1), 1) : els;
+      const std::size_t first = element > 0 ? static_cast<std::size_t>(element - 1) : 0;
+      if (method == "bond")
+        flatjoint::bond(fj, part, first);
+      else
+        flatjoint::unbond(fj, part);
+      break;
+    }
+    case ModelKind::SmoothJoint: {
+      SmoothJointContact& sj = batches_.smoothjoint[c.slot];
+      if (method == "bond")
+        smoothjoint::bond(sj, gap, gap_lo, gap_hi);
+      else if (method == "unbond")
+        smoothjoint::unbond(sj, gap, gap_lo, gap_hi);
+      else
+        smoothjoint::set_force(sj, outputs_[ci].force);
+      break;
+    }
+    case ModelKind::Linear:
+      break;
+    }
+    outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);
+  }
+  return count;
+}
+
 std::size_t Model::active_contact_count() const {
   std::size_t count = 0;
   for (const ContactOutput& o : outputs_)

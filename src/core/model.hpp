@@ -70,6 +70,11 @@ public:
   double mean_unbalanced_force_ratio() const;
   /// Append the events buffered since the last drain (in a fixed order) to out and clear them.
   void drain_events(std::vector<Event>& out);
+  /// Call a contact-model method on every contact of one model: "bond" / "unbond" (contact gap
+  /// in [gap_lo, gap_hi]; flat joints: `element` 1..N or 0 for all) or "sj_setforce".
+  /// Returns the number of contacts called.
+  std::size_t apply_method(ModelKind kind, const std::string& method, double gap_lo, double gap_hi,
+                           int element = 0);
   /// Number of contacts whose model reports them active (carrying load).
   std::size_t active_contact_count() const;
 

@@ -639,6 +639,33 @@ Scene load_scene(const std::string& path) {
       ch.finish();
       st.set.push_back(bc);
     }
+    for (const auto& [jm, mpath] : run.array("methods", false)) {
+      JsonObject mo(*jm, path, mpath);
+      MethodCall mc;
+      const std::string model = mo.choice("model", {"linearpbond", "flatjoint", "smoothjoint"});
+      mc.model = model == "linearpbond"
+                     ? ModelKind::PBond
+                     : (model == "flatjoint" ? ModelKind::FlatJoint : ModelKind::SmoothJoint);
+      mc.method = model == "smoothjoint" ? mo.choice("method", {"bond", "unbond", "sj_setforce"})
+                                         : mo.choice("method", {"bond", "unbond"});
+      if (mo.has("gap")) {
+        const auto& g = mo.raw("gap");
+        if (g.is_number()) {
+          mc.gap_hi = g.get<double>();
+        } else if (g.is_array() && g.size() == 2 && g[0].is_number() && g[1].is_number() &&
+                   g[0].get<double>() <= g[1].get<double>()) {
+          mc.gap_lo = g[0].get<double>();
+          mc.gap_hi = g[1].get<double>();
+        } else {
+          mo.fail("gap",
+                  "expected a maximum gap or [lo, hi] in m with lo <= hi, got " + describe(g));
+        }
+      }
+      if (model == "flatjoint")
+        mc.element = static_cast<int>(mo.integer("element", 0, 1'000'000, 0));
+      mo.finish();
+      st.methods.push_back(mc);
+    }
     run.finish();
     const int stops = (st.run.cycles > 0) + (st.run.time > 0) + (st.run.ratio > 0);
     if (stops != 1)

@@ -51,9 +51,18 @@ struct BallChange {
 
 /// One stage of a run: changes applied at its start, then cycles until its stop rule. Cycle and
 /// time limits count from the start of the stage.
+/// A contact-model method called at the start of a stage on every contact of one model.
+struct MethodCall {
+  ModelKind model = ModelKind::PBond;
+  std::string method;
+  double gap_lo = -1e300, gap_hi = 0;
+  int element = 0;
+};
+
 struct Stage {
   RunSpec run;
   std::vector<BallChange> set;
+  std::vector<MethodCall> methods;
 };
 
 struct Scene {
