@@ -69,13 +69,64 @@ void BM_LinearDense3D_20k(benchmark::State& state) {
   run_cycles(state, m);
 }
 
+// The bonded models on the same packing: bonds installed at every contact, strengths high
+// enough that nothing breaks (this measures the elastic cycle).
+void BM_PBondDense3D_20k(benchmark::State& state) {
+  PBondProps p;
+  p.linear.emod = 1e9;
+  p.linear.kratio = 1.5;
+  p.linear.fric = 0.5;
+  p.pb_emod = 1e9;
+  p.pb_kratio = 1.5;
+  p.pb_ten = p.pb_coh = 1e12;
+  p.bond = true;
+  p.bond_gap_hi = 1e-4;
+  static Model m = dense_packing(20000, p);
+  run_cycles(state, m);
+}
+
+FlatJointProps fj_bench_props(bool exact) {
+  FlatJointProps p; // N_r = 2, N_alpha = 4: 8 elements
+  p.fj_emod = 1e9;
+  p.fj_kratio = 1.5;
+  p.fj_ten = p.fj_coh = 1e12;
+  p.fj_fric = 0.5;
+  p.bond = true;
+  p.fj_exact = exact;
+  return p;
+}
+
+void BM_FlatJoint8Dense3D_20k(benchmark::State& state) {
+  static Model m = dense_packing(20000, fj_bench_props(false));
+  run_cycles(state, m);
+}
+
+void BM_FlatJoint8ExactDense3D_20k(benchmark::State& state) {
+  static Model m = dense_packing(20000, fj_bench_props(true));
+  run_cycles(state, m);
+}
+
+void BM_SmoothJointDense3D_20k(benchmark::State& state) {
+  SmoothJointProps p;
+  p.sj_kn = 1e12;
+  p.sj_ks = 5e11;
+  p.sj_fric = 0.5;
+  p.dip = 30;
+  p.ddir = 45;
+  static Model m = dense_packing(20000, p);
+  run_cycles(state, m);
+}
+
+void configure(benchmark::internal::Benchmark* b) {
+  b->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond)->MinTime(3.0);
+}
+
 } // namespace
 
-BENCHMARK(BM_LinearDense3D_20k)
-    ->Arg(1)
-    ->Arg(2)
-    ->UseRealTime()
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(3.0);
+BENCHMARK(BM_LinearDense3D_20k)->Apply(configure);
+BENCHMARK(BM_PBondDense3D_20k)->Apply(configure);
+BENCHMARK(BM_FlatJoint8Dense3D_20k)->Apply(configure);
+BENCHMARK(BM_FlatJoint8ExactDense3D_20k)->Apply(configure);
+BENCHMARK(BM_SmoothJointDense3D_20k)->Apply(configure);
 
 BENCHMARK_MAIN();
