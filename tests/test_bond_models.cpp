@@ -464,3 +464,32 @@ TEST(SmoothJoint, BlockOnAnInclinedJointSlidesAtTheCoulombLimit) {
   EXPECT_EQ(rw.breaks, 1);
   EXPECT_TRUE(near_rel(rw.along, w.along, 1e-9));
 }
+
+TEST(SmoothJoint, InheritsSurfacePropertiesInSeries) {
+  const std::filesystem::path file =
+      std::filesystem::temp_directory_path() / "rocklab-inherit.json";
+  std::ofstream(file) << R"({
+    "dimension": 3,
+    "balls": [{"id": 1, "position": [0, 0, 0], "radius": 0.005, "density": 2650, "group": "a"},
+              {"id": 2, "position": [0, 0, 0.0099], "radius": 0.005, "density": 2650, "group": "b"},
+              {"id": 3, "position": [0.0099, 0, 0], "radius": 0.005, "density": 2650, "group": "a"}],
+    "surface": [{"group": "a", "sj_kn": 2e12, "sj_ks": 1e12, "sj_fric": 0.4, "kn": 1e6, "fric": 0.2},
+                {"group": "b", "sj_kn": 2e12, "sj_ks": 3e12, "sj_fric": 0.6, "kn": 3e6, "fric": 0.7}],
+    "contact_models": [
+      {"between": "ball-ball", "groups": ["a", "b"], "model": "smoothjoint",
+       "properties": {"inherit": true, "sj_kn": 1, "dip": 10}},
+      {"between": "ball-ball", "groups": ["a", "a"], "model": "linear",
+       "properties": {"inherit": true, "kn": 5}}],
+    "run": {"cycles": 1}})";
+  Scene s = load_scene(file.string());
+  s.model->initialize();
+  const ModelBatches& b = s.model->batches();
+  ASSERT_EQ(b.smoothjoint.size(), 1u);                        // balls 1 (a) and 2 (b)
+  EXPECT_TRUE(near_rel(b.smoothjoint[0].kn, 1e12, 1e-15));    // 2e12 and 2e12 in series
+  EXPECT_TRUE(near_rel(b.smoothjoint[0].ks, 0.75e12, 1e-15)); // 1e12 and 3e12 in series
+  EXPECT_EQ(b.smoothjoint[0].fric, 0.4);
+  ASSERT_EQ(b.linear.size(), 1u); // balls 1 and 3 (a, a)
+  EXPECT_TRUE(near_rel(b.linear[0].p.kn, 0.5e6, 1e-15));
+  EXPECT_EQ(b.linear[0].p.fric, 0.2);
+  EXPECT_EQ(b.linear[0].p.ks, 0.0); // not held by the groups: the rule value stays
+}

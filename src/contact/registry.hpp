@@ -7,6 +7,8 @@
 #include "contact/parallel_bond.hpp"
 #include "contact/smooth_joint.hpp"
 
+#include <cmath>
+#include <limits>
 #include <span>
 #include <string_view>
 #include <variant>
@@ -59,6 +61,47 @@ using ModelProps = std::variant<LinearProps, PBondProps, FlatJointProps, SmoothJ
 
 inline ModelKind kind_of(const ModelProps& p) {
   return static_cast<ModelKind>(p.index());
+}
+
+/// Surface properties of the pieces of one group, inherited by contacts whose rule asks for it.
+/// NaN: the group does not hold the property.
+struct SurfaceProps {
+  double kn = std::numeric_limits<double>::quiet_NaN();      ///< [N/m]
+  double ks = std::numeric_limits<double>::quiet_NaN();      ///< [N/m]
+  double fric = std::numeric_limits<double>::quiet_NaN();    ///< [-]
+  double sj_kn = std::numeric_limits<double>::quiet_NaN();   ///< [Pa/m]
+  double sj_ks = std::numeric_limits<double>::quiet_NaN();   ///< [Pa/m]
+  double sj_fric = std::numeric_limits<double>::quiet_NaN(); ///< [-]
+};
+
+/// Property inheritance: stiffnesses of the two pieces act in series and the friction is the
+/// smaller one (smooth-joint Eq. 18-19; the linear stiffnesses and friction inherit the same
+/// way). A property is inherited only when both pieces hold it.
+inline void inherit_properties(ModelProps& props, const SurfaceProps& a, const SurfaceProps& b) {
+  auto series = [](double& k, double k1, double k2) {
+    if (!std::isnan(k1) && !std::isnan(k2))
+      k = (k1 > 0 && k2 > 0) ? 1.0 / (1.0 / k1 + 1.0 / k2) : 0.0; // Eq. 18
+  };
+  auto minimum = [](double& mu, double m1, double m2) {
+    if (!std::isnan(m1) && !std::isnan(m2))
+      mu = std::min(m1, m2); // Eq. 19
+  };
+  auto linear_part = [&](LinearProps& p) {
+    if (p.emod <= 0) {
+      series(p.kn, a.kn, b.kn);
+      series(p.ks, a.ks, b.ks);
+    }
+    minimum(p.fric, a.fric, b.fric);
+  };
+  if (auto* l = std::get_if<LinearProps>(&props))
+    linear_part(*l);
+  else if (auto* pb = std::get_if<PBondProps>(&props))
+    linear_part(pb->linear);
+  else if (auto* sj = std::get_if<SmoothJointProps>(&props)) {
+    series(sj->sj_kn, a.sj_kn, b.sj_kn);
+    series(sj->sj_ks, a.sj_ks, b.sj_ks);
+    minimum(sj->sj_fric, a.sj_fric, b.sj_fric);
+  }
 }
 
 /// Geometry a model may need when it is created.

@@ -272,7 +272,18 @@ void Model::detect() {
       info.gap = g.gap;
       info.n = g.n;
     }
-    c.slot = create_contact_data(new_batches_, rule->props, info);
+    if (rule->inherit && !facet) {
+      const SurfaceProps none;
+      auto surf = [&](std::int32_t g) {
+        return static_cast<std::size_t>(g) < surface.size() ? surface[static_cast<std::size_t>(g)]
+                                                            : none;
+      };
+      ModelProps props = rule->props;
+      inherit_properties(props, surf(balls.group[end1]), surf(balls.group[end2]));
+      c.slot = create_contact_data(new_batches_, props, info);
+    } else {
+      c.slot = create_contact_data(new_batches_, rule->props, info);
+    }
     ContactOutput o;
     o.stiff = contact_stiffness(new_batches_, c.model, c.slot);
     new_contacts_.push_back(c);

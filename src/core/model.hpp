@@ -36,6 +36,7 @@ struct ModelRule {
   int group1 = -1;         ///< group of one ball (-1: any)
   int group2 = -1;         ///< group of the other ball (-1: any); unused for ball-facet
   int wall = -1;           ///< wall index for ball-facet rules (-1: any)
+  bool inherit = false;    ///< ball-ball: inherit properties from the pieces' groups
   ModelProps props;
 };
 
@@ -46,6 +47,7 @@ public:
   std::vector<Wall> walls;
   std::vector<std::string> group_names;
   std::vector<ModelRule> rules;
+  std::vector<SurfaceProps> surface; ///< per group index (may be shorter than group_names)
 
   /// Index of a group name, added if new.
   int group_index(const std::string& name);

@@ -457,6 +457,11 @@ void read_contact_models(JsonObject& top, Model& m) {
     if (model == "smoothjoint" && rule.ball_facet)
       o.fail("model", "the smooth-joint model is installed at ball-ball contacts only");
     JsonObject props = o.object("properties");
+    if (model != "flatjoint") {
+      rule.inherit = props.boolean("inherit", false);
+      if (rule.inherit && rule.ball_facet)
+        props.fail("inherit", "walls hold no surface properties; inherit on ball-ball rules only");
+    }
     rule.props = read_model_props(props, model, m.settings.dim);
     o.finish();
     m.rules.push_back(rule);
@@ -604,6 +609,27 @@ Scene load_scene(const std::string& path) {
 
   read_walls(top, m);
   read_balls(top, m);
+  for (const auto& [js, spath] : top.array("surface", false)) {
+    JsonObject so(*js, path, spath);
+    const std::string group = so.string("group");
+    if (std::find(m.group_names.begin(), m.group_names.end(), group) == m.group_names.end())
+      so.fail("group", "no ball is in group \"" + group + "\"");
+    const std::size_t g = static_cast<std::size_t>(m.group_index(group));
+    if (m.surface.size() <= g)
+      m.surface.resize(g + 1);
+    SurfaceProps& sp = m.surface[g];
+    auto opt = [&](const char* key, double& out, const char* unit) {
+      if (so.has(key))
+        out = so.number(key, Range::non_negative(), std::nullopt, unit);
+    };
+    opt("kn", sp.kn, "N/m");
+    opt("ks", sp.ks, "N/m");
+    opt("fric", sp.fric, "");
+    opt("sj_kn", sp.sj_kn, "Pa/m");
+    opt("sj_ks", sp.sj_ks, "Pa/m");
+    opt("sj_fric", sp.sj_fric, "");
+    so.finish();
+  }
   read_contact_models(top, m);
 
   std::vector<std::pair<const nlohmann::json*, std::string>> stages;
