@@ -186,3 +186,19 @@ TEST(Cli, EveryExampleRuns) {
   }
   EXPECT_GE(count, 5u);
 }
+
+TEST(Cli, BondedModelsAreDeterministicAcrossThreads) {
+  for (const char* name : {"interlocked_3d_exact", "smooth_joint_bonded_weak"}) {
+    const std::string scene = source_dir() + "/examples/verification/" + name + ".json";
+    const fs::path a = scratch(std::string("bdet-1-") + name),
+                   b = scratch(std::string("bdet-2-") + name);
+    std::string out;
+    ASSERT_EQ(
+        run_command(binary() + " run " + scene + " -o " + a.string() + " --threads 1 -q", &out), 0)
+        << out;
+    ASSERT_EQ(
+        run_command(binary() + " run " + scene + " -o " + b.string() + " --threads 2 -q", &out), 0)
+        << out;
+    EXPECT_EQ(read_file(a / "results.json"), read_file(b / "results.json")) << name;
+  }
+}

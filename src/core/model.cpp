@@ -327,7 +327,8 @@ void Model::detect() {
     adj_start_[i + 1] += adj_start_[i];
   adj_items_.resize(static_cast<std::size_t>(adj_start_[n]));
   {
-    std::vector<std::int32_t> cursor(adj_start_.begin(), adj_start_.end() - 1);
+    std::vector<std::int32_t>& cursor = adj_cursor_; // reused: no allocation once sized
+    cursor.assign(adj_start_.begin(), adj_start_.end() - 1);
     for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
       const Contact& c = contacts_[ci];
       adj_items_[static_cast<std::size_t>(cursor[static_cast<std::size_t>(c.end1)]++)] =

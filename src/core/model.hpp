@@ -98,6 +98,7 @@ private:
   std::vector<std::vector<std::uint64_t>> thread_keys_;
   std::vector<std::int32_t> cell_start_, cell_items_;
   std::vector<std::int32_t> adj_start_, adj_items_; // ball -> contacts (index*2 + side)
+  std::vector<std::int32_t> adj_cursor_;
   std::vector<EventBuffer> thread_events_;
   std::vector<Event> pending_events_;
 

@@ -25,7 +25,12 @@ std::string fmt(double v) {
 } // namespace
 
 std::string Range::str() const {
-  return std::string(lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + (hi_open ? ")" : "]");
+  std::string s(1, lo_open ? '(' : '[');
+  s += fmt(lo);
+  s += ", ";
+  s += fmt(hi);
+  s += hi_open ? ')' : ']';
+  return s;
 }
 
 std::string describe(const nlohmann::json& v) {
@@ -107,7 +112,11 @@ double JsonObject::number(const std::string& key, Range r, std::optional<double>
 std::int64_t JsonObject::integer(const std::string& key, std::int64_t lo, std::int64_t hi,
                                  std::optional<std::int64_t> def) {
   used_.insert(key);
-  const std::string range = "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  std::string range(1, '[');
+  range += std::to_string(lo);
+  range += ", ";
+  range += std::to_string(hi);
+  range += ']';
   if (!j_.contains(key)) {
     if (def)
       return *def;
@@ -152,8 +161,13 @@ std::string JsonObject::string(const std::string& key, std::optional<std::string
 std::string JsonObject::choice(const std::string& key, std::initializer_list<const char*> allowed,
                                std::optional<std::string> def) {
   std::string list;
-  for (const char* a : allowed)
-    list += (list.empty() ? "" : ", ") + std::string("\"") + a + "\"";
+  for (const char* a : allowed) {
+    if (!list.empty())
+      list += ", ";
+    list += '"';
+    list += a;
+    list += '"';
+  }
   if (!j_.contains(key) && !def) {
     used_.insert(key);
     throw InputError(file_ + ": missing required key '" + key_path(key) + "' (one of " + list +
@@ -225,8 +239,11 @@ void JsonObject::finish() const {
     if (used_.count(it.key()))
       continue;
     std::string allowed;
-    for (const auto& u : used_)
-      allowed += (allowed.empty() ? "" : ", ") + u;
+    for (const auto& u : used_) {
+      if (!allowed.empty())
+        allowed += ", ";
+      allowed += u;
+    }
     throw InputError(file_ + ": unknown key '" + key_path(it.key()) +
                      "' (allowed here: " + allowed + ")");
   }

@@ -193,18 +193,26 @@ nlohmann::json results_json(const Model& m, const EventCounts& counts,
 
 std::string history_header(const std::vector<HistoryColumn>& cols) {
   std::string s;
-  for (std::size_t k = 0; k < cols.size(); ++k)
-    s += (k ? "," : "") + cols[k].name;
-  return s + "\n";
+  for (std::size_t k = 0; k < cols.size(); ++k) {
+    if (k)
+      s += ',';
+    s += cols[k].name;
+  }
+  s += '\n';
+  return s;
 }
 
 std::string history_row(const Model& m, const std::vector<HistoryColumn>& cols,
                         const EventCounts& counts) {
   const EnergyLedger e = m.energy();
   std::string s;
-  for (std::size_t k = 0; k < cols.size(); ++k)
-    s += (k ? "," : "") + format_double(history_value(m, cols[k], e, counts));
-  return s + "\n";
+  for (std::size_t k = 0; k < cols.size(); ++k) {
+    if (k)
+      s += ',';
+    s += format_double(history_value(m, cols[k], e, counts));
+  }
+  s += '\n';
+  return s;
 }
 
 } // namespace rocklab
