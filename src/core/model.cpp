@@ -71,10 +71,17 @@ int Model::group_index(const std::string& name) {
   return static_cast<int>(group_names.size() - 1);
 }
 
-void Model::initialize() {
+void Model::ensure_thread_buffers() {
+  // Per-thread buffers are indexed by thread number; the thread count may change between calls.
   const std::size_t nthreads = static_cast<std::size_t>(omp_get_max_threads());
-  thread_events_.resize(nthreads);
-  thread_keys_.resize(nthreads);
+  if (thread_events_.size() < nthreads)
+    thread_events_.resize(nthreads);
+  if (thread_keys_.size() < nthreads)
+    thread_keys_.resize(nthreads);
+}
+
+void Model::initialize() {
+  ensure_thread_buffers();
   for (auto& w : walls)
     w.update_bounds();
   margin_ = settings.margin;
@@ -103,6 +110,8 @@ void Model::detect() {
   const std::size_t n = balls.size();
   const int dim = settings.dim;
   const std::size_t nthreads = thread_keys_.size();
+  for (auto& k : thread_keys_)
+    k.clear();
   candidate_keys_.clear();
 
   if (n > 0) {
@@ -628,6 +637,7 @@ void Model::law_of_motion(double dt) {
 void Model::cycle(std::int64_t count) {
   if (!initialized_)
     initialize();
+  ensure_thread_buffers();
   for (std::int64_t k = 0; k < count; ++k) {
     const double dt = estimate_timestep();
     dt_ = dt;

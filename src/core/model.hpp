@@ -80,7 +80,11 @@ public:
   /// Number of contacts whose model reports them active (carrying load).
   std::size_t active_contact_count() const;
 
+  /// Read or write the whole state (archive = specimen/checkpoint reader or writer).
+  template <class Archive> void serialize(Archive& a);
+
 private:
+  void ensure_thread_buffers();
   void detect();
   void force_displacement(double dt_increment);
   void law_of_motion(double dt);

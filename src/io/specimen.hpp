@@ -1,0 +1,26 @@
+// Specimen and checkpoint files: a versioned file that restores a Model exactly, so a run
+// continued from it is bit-identical to one that never stopped.
+//
+// Layout: one line of JSON (the header: format, version, counts, and any metadata the caller
+// adds), then a binary body written field by field in little-endian order (no struct padding, so
+// the same model always gives the same bytes).
+#pragma once
+
+#include "core/model.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace rocklab {
+
+inline constexpr int kSpecimenVersion = 1;
+
+/// Write atomically (temporary file, then rename). Throws std::runtime_error naming the file.
+void save_model(const Model& m, const std::string& path, const nlohmann::json& meta = {});
+
+/// Read a file written by save_model; `meta` receives the header's "meta" object.
+/// Throws InputError naming the file on a wrong format, version or truncated body.
+std::unique_ptr<Model> load_model(const std::string& path, nlohmann::json* meta = nullptr);
+
+} // namespace rocklab

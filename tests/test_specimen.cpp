@@ -1,0 +1,117 @@
+// Specimen / checkpoint files: exact restore, deterministic bytes, clean failures.
+#include "helpers.hpp"
+#include "io/results.hpp"
+#include "io/specimen.hpp"
+
+#include <filesystem>
+
+namespace fs = std::filesystem;
+using namespace rocklab;
+
+namespace {
+std::string state(const Model& m) {
+  return results_json(m, {}, "x").dump();
+}
+
+// Settling grains with all four contact models in play: linear with walls, parallel bonds,
+// flat joints and smooth joints between groups, under gravity and local damping.
+std::unique_ptr<Model> busy_model() {
+  Scene s = load_scene(test::source_dir() + "/examples/settling_2k.json");
+  Model& m = *s.model;
+  for (std::size_t i = 0; i < m.balls.size(); ++i)
+    m.balls.group[i] = m.group_index(i % 3 == 0 ? "a" : (i % 3 == 1 ? "b" : "c"));
+  FlatJointProps fj;
+  fj.fj_kn = 2e7;
+  fj.fj_ks = 1e7;
+  fj.fj_ten = fj.fj_coh = 2e3;
+  fj.fj_fric = 0.4;
+  fj.bond = true;
+  PBondProps pb;
+  pb.linear.kn = 2e4;
+  pb.linear.ks = 1e4;
+  pb.linear.fric = 0.5;
+  pb.pb_kn = 1e7;
+  pb.pb_ks = 5e6;
+  pb.pb_ten = pb.pb_coh = 1e3;
+  pb.bond_gap_hi = 1e-4;
+  SmoothJointProps sj;
+  sj.sj_kn = 1e7;
+  sj.sj_ks = 5e6;
+  sj.sj_fric = 0.3;
+  sj.dip = 20;
+  sj.ddir = 60;
+  std::vector<ModelRule> rules;
+  auto rule = [&](const char* g1, const char* g2, ModelProps p) {
+    ModelRule r;
+    r.group1 = m.group_index(g1);
+    r.group2 = m.group_index(g2);
+    r.props = p;
+    rules.push_back(r);
+  };
+  rule("a", "a", fj);
+  rule("b", "b", pb);
+  rule("a", "b", sj);
+  for (const ModelRule& r : m.rules)
+    rules.push_back(r); // the scene's linear rules for everything else
+  m.rules = rules;
+  m.initialize();
+  m.cycle(1500);
+  return std::move(s.model);
+}
+} // namespace
+
+TEST(Specimen, RoundTripContinuesBitForBit) {
+  std::unique_ptr<Model> a = busy_model();
+  ASSERT_GT(a->batches().flatjoint.size(), 0u);
+  ASSERT_GT(a->batches().pbond.size(), 0u);
+  ASSERT_GT(a->batches().smoothjoint.size(), 0u);
+  const fs::path file = fs::temp_directory_path() / "rocklab-roundtrip.rlspec";
+  save_model(*a, file.string(), {{"note", "test"}});
+  nlohmann::json meta;
+  std::unique_ptr<Model> b = load_model(file.string(), &meta);
+  EXPECT_EQ(meta["note"], "test");
+  EXPECT_EQ(state(*a), state(*b));
+  a->cycle(1000);
+  b->cycle(1000);
+  EXPECT_EQ(state(*a), state(*b));
+  EXPECT_EQ(a->step(), b->step());
+  // Saving the restored model gives the same bytes.
+  const fs::path again = fs::temp_directory_path() / "rocklab-roundtrip-2.rlspec";
+  std::unique_ptr<Model> c = load_model(file.string());
+  save_model(*c, again.string(), {{"note", "test"}});
+  EXPECT_EQ(test::read_file(file), test::read_file(again));
+}
+
+TEST(Specimen, BadFilesFailCleanly) {
+  const fs::path dir = fs::temp_directory_path();
+  EXPECT_THROW(load_model((dir / "does-not-exist.rlspec").string()), InputError);
+  const fs::path notjson = dir / "rocklab-notjson.rlspec";
+  std::ofstream(notjson) << "hello\n";
+  try {
+    load_model(notjson.string());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a rocklab specimen"), std::string::npos);
+  }
+  // A truncated body.
+  std::unique_ptr<Model> m = busy_model();
+  const fs::path file = dir / "rocklab-trunc.rlspec";
+  save_model(*m, file.string());
+  std::string bytes = test::read_file(file);
+  std::ofstream(file, std::ios::binary) << bytes.substr(0, bytes.size() - 100);
+  try {
+    load_model(file.string());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
+  }
+  // A newer version.
+  bytes.replace(bytes.find("\"version\":1"), 11, "\"version\":9");
+  std::ofstream(file, std::ios::binary) << bytes;
+  try {
+    load_model(file.string());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'version'"), std::string::npos) << e.what();
+  }
+}
