@@ -397,7 +397,10 @@ void Model::force_displacement(double dt) {
         }
         g = ball_facet_plane(x1, R1, xf);
         xb2 = wall.center;
-        v2 = wall.velocity;
+        // A radially moving wall adds its radial speed at the contact point.
+        v2 = wall.radial_velocity != 0
+                 ? Vec3(wall.velocity + wall.radial_velocity * wall.radial_dir(g.xc))
+                 : wall.velocity;
         w2 = wall.spin;
       }
       const bool fresh = !c.initialized;
@@ -495,6 +498,7 @@ void Model::force_displacement(double dt) {
   for (Wall& w : walls) {
     w.force.setZero();
     w.moment.setZero();
+    w.radial_force = 0;
   }
   for (std::size_t ci = 0; ci < nc; ++ci) {
     const Contact& c = contacts_[ci];
@@ -504,6 +508,7 @@ void Model::force_displacement(double dt) {
     Wall& w = walls[static_cast<std::size_t>(c.end2)];
     w.force += o.force;
     w.moment += o.moment + (o.xc - w.center).cross(o.force);
+    w.radial_force += o.force.dot(w.radial_dir(o.xc));
   }
 
   if (blowup != none) {
@@ -645,7 +650,9 @@ void Model::cycle(std::int64_t count) {
     double wall_work = 0;
     for (Wall& w : walls) {
       // Energy a moving wall puts in: the force on the balls (-force) times the wall motion.
-      wall_work -= (w.force.dot(w.velocity) + w.moment.dot(w.spin)) * dt;
+      wall_work -=
+          (w.force.dot(w.velocity) + w.moment.dot(w.spin) + w.radial_force * w.radial_velocity) *
+          dt;
       wall_disp_ += w.max_vertex_speed() * dt;
       w.move(dt);
     }
@@ -759,6 +766,85 @@ std::size_t Model::apply_method(ModelKind kind, const std::string& method, doubl
     outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);
   }
   return count;
+}
+
+void Model::replace_contact_model(std::size_t ci, const ModelProps& props) {
+  Contact& c = contacts_[ci];
+  // Dissipation so far stays in the ledger; the old data is dropped at the next compaction.
+  ContactEnergy e = contact_energy(batches_, c.model, c.slot);
+  e.strain = e.bond_strain = 0;
+  retired_ += e;
+  CreationInfo info;
+  info.dim = settings.dim;
+  info.R1 = balls.radius[static_cast<std::size_t>(c.end1)];
+  info.ball_facet = c.kind == ContactKind::BallFacet;
+  info.R2 = info.ball_facet ? 0.0 : balls.radius[static_cast<std::size_t>(c.end2)];
+  info.gap = c.gap;
+  info.n = c.n;
+  c.model = kind_of(props);
+  c.slot = create_contact_data(batches_, props, info);
+  outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);
+}
+
+void Model::remove_balls(const std::vector<bool>& remove) {
+  const std::size_t n = balls.size();
+  std::vector<std::int32_t> map(n, -1);
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!remove[i])
+      map[i] = static_cast<std::int32_t>(kept++);
+  auto compact = [&](auto& v) {
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (!remove[i])
+        v[j++] = v[i];
+    v.resize(kept);
+  };
+  compact(balls.pos), compact(balls.vel), compact(balls.spin), compact(balls.force);
+  compact(balls.moment), compact(balls.applied_force), compact(balls.applied_moment);
+  compact(balls.disp), compact(balls.radius), compact(balls.mass), compact(balls.inertia);
+  compact(balls.density), compact(balls.fixity), compact(balls.group), compact(balls.id);
+  // Contacts of removed balls go; the others keep their order (the index map is monotonic).
+  new_contacts_.clear();
+  new_outputs_.clear();
+  new_batches_.clear();
+  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+    Contact c = contacts_[ci];
+    const bool bb = c.kind == ContactKind::BallBall;
+    if (remove[static_cast<std::size_t>(c.end1)] ||
+        (bb && remove[static_cast<std::size_t>(c.end2)])) {
+      ContactEnergy e = contact_energy(batches_, c.model, c.slot);
+      e.strain = e.bond_strain = 0;
+      retired_ += e;
+      continue;
+    }
+    c.end1 = map[static_cast<std::size_t>(c.end1)];
+    if (bb)
+      c.end2 = map[static_cast<std::size_t>(c.end2)];
+    c.key = contact_key(c.kind, c.end1, c.end2);
+    c.slot = move_contact_data(new_batches_, batches_, c.model, c.slot);
+    new_contacts_.push_back(c);
+    new_outputs_.push_back(outputs_[ci]);
+  }
+  std::swap(contacts_, new_contacts_);
+  std::swap(outputs_, new_outputs_);
+  std::swap(batches_, new_batches_);
+  if (initialized_)
+    detect(); // rebuilds the adjacency; new candidates may appear
+}
+
+Eigen::Matrix3d Model::average_stress(double volume) const {
+  // sigma = (1/V) sum over balls and their contacts of (x_c - x_b) (x) f, tension positive.
+  Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
+  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+    const Contact& c = contacts_[ci];
+    const ContactOutput& o = outputs_[ci];
+    s -= (o.xc - balls.pos[static_cast<std::size_t>(c.end1)]) * o.force.transpose();
+    if (c.kind == ContactKind::BallBall)
+      s += (o.xc - balls.pos[static_cast<std::size_t>(c.end2)]) * o.force.transpose();
+  }
+  s /= volume;
+  return 0.5 * (s + s.transpose());
 }
 
 std::size_t Model::active_contact_count() const {

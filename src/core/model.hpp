@@ -77,6 +77,13 @@ public:
   /// Returns the number of contacts called.
   std::size_t apply_method(ModelKind kind, const std::string& method, double gap_lo, double gap_hi,
                            int element = 0);
+  /// Give contact `ci` a new model (material finalization, joint insertion).
+  void replace_contact_model(std::size_t ci, const ModelProps& props);
+  /// Remove the balls flagged in `remove` and their contacts (cutting a specimen, floaters).
+  void remove_balls(const std::vector<bool>& remove);
+  /// Average stress tensor of the balls in `volume` [m^3] (2D: area x unit thickness) from the
+  /// contact forces (Love's formula), tension positive [Pa].
+  Eigen::Matrix3d average_stress(double volume) const;
   /// Number of contacts whose model reports them active (carrying load).
   std::size_t active_contact_count() const;
 

@@ -19,8 +19,11 @@ void Wall::move(double dt) {
   const Vec3 phi = spin * dt;
   const bool rotates = phi.squaredNorm() > 0;
   for (Facet& f : facets)
-    for (int k = 0; k < f.nv; ++k)
+    for (int k = 0; k < f.nv; ++k) {
+      if (radial_velocity != 0)
+        f.v[k] += radial_velocity * dt * radial_dir(f.v[k]);
       f.v[k] = rotates ? (center + rotate_by(f.v[k] - center, phi) + dx) : Vec3(f.v[k] + dx);
+    }
   center += dx;
   update_bounds();
 }
@@ -30,7 +33,8 @@ double Wall::max_vertex_speed() const {
   const double w = spin.norm();
   for (const Facet& f : facets)
     for (int k = 0; k < f.nv; ++k)
-      vmax = std::max(vmax, velocity.norm() + w * (f.v[k] - center).norm());
+      vmax = std::max(vmax,
+                      velocity.norm() + w * (f.v[k] - center).norm() + std::abs(radial_velocity));
   return vmax;
 }
 

@@ -19,11 +19,16 @@ struct Facet {
 struct Wall {
   std::string name;
   std::vector<Facet> facets;
-  Vec3 center = Vec3::Zero();                ///< centre of rotation [m]
-  Vec3 velocity = Vec3::Zero();              ///< translational velocity [m/s]
-  Vec3 spin = Vec3::Zero();                  ///< rotational velocity about center [rad/s]
-  Vec3 force = Vec3::Zero();                 ///< resultant contact force acting on the wall [N]
-  Vec3 moment = Vec3::Zero();                ///< resultant contact moment about center [N m]
+  Vec3 center = Vec3::Zero();   ///< centre of rotation [m]
+  Vec3 velocity = Vec3::Zero(); ///< translational velocity [m/s]
+  Vec3 spin = Vec3::Zero();     ///< rotational velocity about center [rad/s]
+  /// Radial motion: every point moves away from the axis (through `center`, along `axis`) at
+  /// this speed, so a cylindrical or circular wall grows or shrinks [m/s].
+  double radial_velocity = 0;
+  Vec3 axis = Vec3::UnitZ();
+  double radial_force = 0;    ///< sum of contact force components along the outward radius [N]
+  Vec3 force = Vec3::Zero();  ///< resultant contact force acting on the wall [N]
+  Vec3 moment = Vec3::Zero(); ///< resultant contact moment about center [N m]
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero(); ///< bounding box [m]
 
   void update_bounds();
@@ -31,6 +36,13 @@ struct Wall {
   void move(double dt);
   /// Largest distance a vertex moves in one step of length dt [m].
   double max_vertex_speed() const;
+  /// Outward radial unit vector at p (zero on the axis).
+  Vec3 radial_dir(const Vec3& p) const {
+    Vec3 r = p - center;
+    r -= r.dot(axis) * axis;
+    const double n = r.norm();
+    return n > 0 ? Vec3(r / n) : Vec3::Zero();
+  }
 };
 
 /// Closest point of a facet to p.

@@ -168,7 +168,8 @@ template <class A> void io(A& a, Wall& w) {
     for (auto& v : f.v)
       a(v);
   });
-  a(w.center), a(w.velocity), a(w.spin), a(w.force), a(w.moment), a(w.lo), a(w.hi);
+  a(w.center), a(w.velocity), a(w.spin), a(w.radial_velocity), a(w.axis), a(w.radial_force),
+      a(w.force), a(w.moment), a(w.lo), a(w.hi);
 }
 template <class A> void io(A& a, ModelRule& r) {
   a(r.ball_facet), a(r.group1), a(r.group2), a(r.wall), a(r.inherit);
