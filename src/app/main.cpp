@@ -1,6 +1,9 @@
 // rocklab command-line interface. All quantities in input and output files are SI.
+#include "io/output_dir.hpp"
 #include "io/scene.hpp"
 #include "io/scene_run.hpp"
+#include "io/specimen.hpp"
+#include "materials/genesis.hpp"
 
 #include <CLI/CLI.hpp>
 #include <omp.h>
@@ -49,6 +52,63 @@ int run_command(const std::string& scene_file, const std::string& out_dir, bool 
   return 0;
 }
 
+int genesis_command(const std::string& material_file, const std::string& out, bool quiet) {
+  const rocklab::MaterialCard card = rocklab::load_material_card(material_file);
+  const bool tty = !quiet && ::isatty(STDERR_FILENO);
+  rocklab::GenesisResult g = rocklab::run_genesis(card, [&](const std::string& phase) {
+    if (tty)
+      std::fprintf(stderr, "[rocklab genesis] %s\n", phase.c_str());
+  });
+  if (g_interrupt.load())
+    throw std::runtime_error("interrupted; no specimen was written");
+  const nlohmann::json report = g.report.to_json();
+  nlohmann::json report_in_specimen = report;
+  report_in_specimen.erase("seconds"); // the specimen's bytes depend only on the inputs
+  const nlohmann::json meta{{"rocklab_version", ROCKLAB_VERSION},
+                            {"material_file", material_file},
+                            {"material_name", card.name},
+                            {"material_hash", card.text_hash},
+                            {"seed", card.seed},
+                            {"material", card.raw},
+                            {"report", report_in_specimen}};
+  // The report first (atomically), then the specimen: a specimen never lacks its report.
+  const std::string report_file = out + ".report.json";
+  rocklab::write_text_file(report_file + ".partial", report.dump(1) + "\n");
+  try {
+    rocklab::save_model(*g.model, out, meta);
+  } catch (...) {
+    std::remove((report_file + ".partial").c_str());
+    throw;
+  }
+  std::rename((report_file + ".partial").c_str(), report_file.c_str());
+  if (!quiet) {
+    const rocklab::GenesisReport& r = g.report;
+    std::printf("material     %s (%s, hash %s)\n", card.name.c_str(), material_file.c_str(),
+                card.text_hash.c_str());
+    std::printf("grains       %lld (floaters %lld)   contacts %lld   coordination %.3f\n",
+                static_cast<long long>(r.grains), static_cast<long long>(r.floaters),
+                static_cast<long long>(r.contacts), r.coordination);
+    std::printf("porosity     target %.4f  packed %.4f  installed %.4f\n", r.porosity_target,
+                r.porosity_packed, r.porosity);
+    std::printf(
+        "bonds        flat joints: %lld bonded, %lld gapped, %lld slit; parallel bonds %lld; "
+        "linear %lld; smooth joints %lld\n",
+        static_cast<long long>(r.fj_bonded), static_cast<long long>(r.fj_gapped),
+        static_cast<long long>(r.fj_slit), static_cast<long long>(r.pb_bonded),
+        static_cast<long long>(r.linear), static_cast<long long>(r.smoothjoint));
+    std::printf("stress [Pa]  requested %.4g;", r.pressure);
+    for (const auto& [name, s] : r.wall_stress)
+      std::printf(" %s %.4g", name.c_str(), s);
+    std::printf("\n             residual mean stress after release %.4g\n", r.residual_mean_stress);
+    std::printf("steps        packing %lld  installation %lld  release %lld   wall time %.1f s\n",
+                static_cast<long long>(r.steps_packing),
+                static_cast<long long>(r.steps_installation),
+                static_cast<long long>(r.steps_release), r.seconds);
+    std::printf("wrote        %s, %s\n", out.c_str(), report_file.c_str());
+  }
+  return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -71,6 +131,15 @@ int main(int argc, char** argv) {
   run->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
   run->add_flag("-q,--quiet", quiet, "No progress line and no summary");
 
+  std::string material_file, specimen_out;
+  CLI::App* gen = app.add_subcommand(
+      "genesis", "Make a specimen from a material card (docs/material-format.md); writes "
+                 "SPECIMEN and SPECIMEN.report.json");
+  gen->add_option("material", material_file, "Material card (JSON)")->required();
+  gen->add_option("-o,--out", specimen_out, "Specimen file to write")->required();
+  gen->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
+  gen->add_flag("-q,--quiet", quiet, "No progress and no summary");
+
   CLI::App* info = app.add_subcommand("info", "Print the version, threads and contact models");
 
   CLI11_PARSE(app, argc, argv);
@@ -82,9 +151,12 @@ int main(int argc, char** argv) {
   try {
     if (*run)
       return run_command(scene_file, out_dir, quiet);
+    if (*gen)
+      return genesis_command(material_file, specimen_out, quiet);
     if (*info) {
-      std::printf("rocklab %s\nthreads %d\ncontact models: linear\nunits: SI\n", ROCKLAB_VERSION,
-                  omp_get_max_threads());
+      std::printf("rocklab %s\nthreads %d\ncontact models: linear, linearpbond, flatjoint, "
+                  "smoothjoint\nunits: SI\n",
+                  ROCKLAB_VERSION, omp_get_max_threads());
       return 0;
     }
   } catch (const rocklab::InputError& e) {

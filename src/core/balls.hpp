@@ -29,6 +29,14 @@ struct Balls {
 
   std::size_t size() const { return pos.size(); }
 
+  /// Change a radius, keeping density: mass and inertia follow.
+  void set_radius(std::size_t i, double r, int dim) {
+    const double pi = std::numbers::pi;
+    radius[i] = r;
+    mass[i] = dim == 2 ? density[i] * pi * r * r : density[i] * 4.0 / 3.0 * pi * r * r * r;
+    inertia[i] = (dim == 2 ? 0.5 : 0.4) * mass[i] * r * r;
+  }
+
   /// Append a ball; mass and inertia follow from density (2D: unit-thickness disk).
   std::size_t add(int dim, std::int64_t user_id, const Vec3& x, double r, double rho,
                   std::int32_t group_index) {

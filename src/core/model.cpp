@@ -58,7 +58,7 @@ bool rule_matches_balls(const ModelRule& r, int ga, int gb) {
 bool rule_matches_facet(const ModelRule& r, int g, int wall) {
   if (!r.ball_facet)
     return false;
-  return (r.group1 < 0 || r.group1 == g) && (r.wall < 0 || r.wall == wall);
+  return (r.group1 < 0 || r.group1 == g) && (r.wall == -1 || r.wall == wall);
 }
 
 } // namespace
@@ -419,7 +419,8 @@ void Model::force_displacement(double dt) {
       // Blow-up: overlap beyond a radius. A facet contact measures an unsigned distance, so
       // there the overlap reaching the radius shows as the normal flipping within one step.
       const bool through = c.kind == ContactKind::BallFacet && !fresh && g.n.dot(c.n) < 0;
-      if (g.gap < -std::min(R1, c.kind == ContactKind::BallBall ? R2 : R1) || through ||
+      if ((settings.overlap_check &&
+           (g.gap < -std::min(R1, c.kind == ContactKind::BallBall ? R2 : R1) || through)) ||
           !std::isfinite(g.gap))
         blowup = std::min(blowup, ci);
       out.xc = g.xc;
@@ -766,6 +767,52 @@ std::size_t Model::apply_method(ModelKind kind, const std::string& method, doubl
     outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);
   }
   return count;
+}
+
+void Model::set_margin(double margin) {
+  settings.margin = margin;
+  margin_ = margin;
+  if (initialized_)
+    detect();
+}
+
+void Model::remove_walls(const std::vector<bool>& remove) {
+  std::vector<std::int32_t> map(walls.size(), -1);
+  std::vector<Wall> kept;
+  for (std::size_t w = 0; w < walls.size(); ++w)
+    if (!remove[w]) {
+      map[w] = static_cast<std::int32_t>(kept.size());
+      kept.push_back(walls[w]);
+    }
+  new_contacts_.clear();
+  new_outputs_.clear();
+  new_batches_.clear();
+  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+    Contact c = contacts_[ci];
+    if (c.kind == ContactKind::BallFacet) {
+      if (remove[static_cast<std::size_t>(c.end2)]) {
+        ContactEnergy e = contact_energy(batches_, c.model, c.slot);
+        e.strain = e.bond_strain = 0;
+        retired_ += e;
+        continue;
+      }
+      c.end2 = map[static_cast<std::size_t>(c.end2)];
+      c.key = contact_key(c.kind, c.end1, c.end2);
+    }
+    c.slot = move_contact_data(new_batches_, batches_, c.model, c.slot);
+    new_contacts_.push_back(c);
+    new_outputs_.push_back(outputs_[ci]);
+  }
+  std::swap(contacts_, new_contacts_);
+  std::swap(outputs_, new_outputs_);
+  std::swap(batches_, new_batches_);
+  walls = std::move(kept);
+  for (ModelRule& r : rules)
+    if (r.wall >= 0) // a rule for a removed wall never matches again (-2)
+      r.wall =
+          map[static_cast<std::size_t>(r.wall)] >= 0 ? map[static_cast<std::size_t>(r.wall)] : -2;
+  if (initialized_)
+    detect();
 }
 
 void Model::replace_contact_model(std::size_t ci, const ModelProps& props) {

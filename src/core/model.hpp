@@ -28,6 +28,7 @@ struct ModelSettings {
   double timestep = 0;          ///< > 0: fixed time step [s]; 0: automatic
   double timestep_safety = 0.8; ///< factor on the automatic estimate [-], (0, 1]
   double margin = 0;            ///< proximity margin [m]; 0: 0.1 x mean radius
+  bool overlap_check = true;    ///< stop on an overlap beyond a radius (off for grain clouds)
 };
 
 /// Which model a new contact gets. The first matching rule wins.
@@ -77,6 +78,10 @@ public:
   /// Returns the number of contacts called.
   std::size_t apply_method(ModelKind kind, const std::string& method, double gap_lo, double gap_hi,
                            int element = 0);
+  /// Change the proximity margin and re-detect (e.g. to reach an installation gap) [m].
+  void set_margin(double margin);
+  /// Remove the walls flagged in `remove` and their contacts.
+  void remove_walls(const std::vector<bool>& remove);
   /// Give contact `ci` a new model (material finalization, joint insertion).
   void replace_contact_model(std::size_t ci, const ModelProps& props);
   /// Remove the balls flagged in `remove` and their contacts (cutting a specimen, floaters).

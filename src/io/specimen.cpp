@@ -199,7 +199,7 @@ template <class A, class T> void each(A& a, std::vector<T>& v) {
 
 template <class A> void Model::serialize(A& a) {
   a(settings.dim), a(settings.gravity), a(settings.local_damping), a(settings.timestep),
-      a(settings.timestep_safety), a(settings.margin);
+      a(settings.timestep_safety), a(settings.margin), a(settings.overlap_check);
   each(a, balls.pos), each(a, balls.vel), each(a, balls.spin), each(a, balls.force),
       each(a, balls.moment), each(a, balls.applied_force), each(a, balls.applied_moment),
       each(a, balls.disp), each(a, balls.radius), each(a, balls.mass), each(a, balls.inertia),

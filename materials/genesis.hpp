@@ -1,0 +1,38 @@
+// Material genesis: turn a material card into a specimen (packed, stressed, finalized, released).
+// Units: SI.
+#pragma once
+
+#include "core/model.hpp"
+#include "materials/material_card.hpp"
+
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+namespace rocklab {
+
+struct GenesisReport {
+  std::int64_t grains = 0, floaters = 0;
+  std::int64_t contacts = 0, fj_bonded = 0, fj_gapped = 0, fj_slit = 0, pb_bonded = 0, linear = 0,
+               smoothjoint = 0;
+  double porosity_target = 0, porosity_packed = 0, porosity = 0;
+  double coordination = 0; ///< mean ball-ball contacts carrying force per grain (no floaters)
+  double pressure = 0;     ///< requested installation pressure [Pa]
+  std::vector<std::pair<std::string, double>> wall_stress; ///< at the end of installation [Pa]
+  double residual_mean_stress = 0; ///< after release [Pa], compression positive
+  std::int64_t steps_packing = 0, steps_installation = 0, steps_release = 0;
+  double seconds = 0;
+  nlohmann::json to_json() const;
+};
+
+struct GenesisResult {
+  std::unique_ptr<Model> model;
+  GenesisReport report;
+};
+
+/// Run material genesis. Throws PhysicsError on blow-up and std::runtime_error when a phase does
+/// not reach its criterion within the card's max_cycles.
+GenesisResult run_genesis(const MaterialCard& card,
+                          const std::function<void(const std::string&)>& progress = {});
+
+} // namespace rocklab

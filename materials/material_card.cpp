@@ -1,0 +1,275 @@
+#include "materials/material_card.hpp"
+
+#include "io/json_input.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+namespace rocklab {
+
+double ShapeSpec::volume(int dim) const {
+  const double pi = std::numbers::pi;
+  switch (shape) {
+  case SpecimenShape::Rectangle:
+    return size.x() * size.y();
+  case SpecimenShape::Disk2D:
+    return 0.25 * pi * size.x() * size.x();
+  case SpecimenShape::Prism:
+    return size.x() * size.y() * size.z();
+  case SpecimenShape::Cylinder:
+  case SpecimenShape::Disk3D:
+    return 0.25 * pi * size.x() * size.x() * size.y();
+  }
+  (void)dim;
+  return 0;
+}
+
+bool ShapeSpec::contains(const Vec3& x, double m) const {
+  switch (shape) {
+  case SpecimenShape::Rectangle:
+    return std::abs(x.x()) <= 0.5 * size.x() - m && std::abs(x.y()) <= 0.5 * size.y() - m;
+  case SpecimenShape::Disk2D:
+    return std::hypot(x.x(), x.y()) <= 0.5 * size.x() - m;
+  case SpecimenShape::Prism:
+    return std::abs(x.x()) <= 0.5 * size.x() - m && std::abs(x.y()) <= 0.5 * size.y() - m &&
+           std::abs(x.z()) <= 0.5 * size.z() - m;
+  case SpecimenShape::Cylinder:
+  case SpecimenShape::Disk3D:
+    return std::hypot(x.x(), x.y()) <= 0.5 * size.x() - m && std::abs(x.z()) <= 0.5 * size.y() - m;
+  }
+  return false;
+}
+
+std::string text_hash(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+namespace {
+
+ShapeSpec read_shape(JsonObject o, int dim) {
+  ShapeSpec s;
+  const std::string shape = dim == 2 ? o.choice("shape", {"rectangle", "disk"})
+                                     : o.choice("shape", {"prism", "cylinder", "disk"});
+  const Range pos = Range::positive();
+  if (shape == "rectangle") {
+    s.shape = SpecimenShape::Rectangle;
+    s.size = Vec3(o.number("width", pos, std::nullopt, "m"),
+                  o.number("height", pos, std::nullopt, "m"), 0);
+  } else if (shape == "disk" && dim == 2) {
+    s.shape = SpecimenShape::Disk2D;
+    s.size = Vec3(o.number("diameter", pos, std::nullopt, "m"), 0, 0);
+  } else if (shape == "prism") {
+    s.shape = SpecimenShape::Prism;
+    s.size = o.vec("size", 3, std::nullopt, Range::positive());
+  } else if (shape == "cylinder") {
+    s.shape = SpecimenShape::Cylinder;
+    s.size = Vec3(o.number("diameter", pos, std::nullopt, "m"),
+                  o.number("height", pos, std::nullopt, "m"), 0);
+  } else {
+    s.shape = SpecimenShape::Disk3D;
+    s.size = Vec3(o.number("diameter", pos, std::nullopt, "m"),
+                  o.number("thickness", pos, std::nullopt, "m"), 0);
+  }
+  o.finish();
+  return s;
+}
+
+Distribution read_dist(JsonObject& o, const std::string& key, const char* unit) {
+  Distribution d;
+  if (!o.has(key))
+    o.fail(key, std::string("missing (a number or {\"mean\", \"sd\"} in ") + unit + ")");
+  const auto& v = o.raw(key);
+  if (v.is_number()) {
+    d.mean = v.get<double>();
+    if (d.mean < 0)
+      o.fail(key, "value " + v.dump() + " is out of range [0, +inf) " + unit);
+    return d;
+  }
+  JsonObject m(v, o.file(), o.key_path(key));
+  d.mean = m.number("mean", Range::non_negative(), std::nullopt, unit);
+  d.sd = m.number("sd", Range::non_negative(), 0.0, unit);
+  m.finish();
+  return d;
+}
+
+LinearProps read_linear(JsonObject o) {
+  LinearProps p;
+  if (o.has("emod")) {
+    p.emod = o.number("emod", Range::positive(), std::nullopt, "Pa");
+    p.kratio = o.number("kratio", Range::non_negative(), 0.0);
+  } else {
+    p.kn = o.number("kn", Range::positive(), std::nullopt, "N/m");
+    p.ks = o.number("ks", Range::non_negative(), 0.0, "N/m");
+  }
+  p.fric = o.number("fric", Range::non_negative(), 0.0);
+  o.finish();
+  return p;
+}
+
+} // namespace
+
+MaterialCard load_material_card(const std::string& path) {
+  MaterialCard c;
+  c.file = path;
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    c.text_hash = text_hash(ss.str());
+  }
+  c.raw = read_json_file(path);
+  JsonObject top(c.raw, path, "");
+  if (top.has("units") && top.string("units") != "SI")
+    top.fail("units", "only \"SI\" is supported");
+  c.name = top.string("name");
+  c.source = top.string("source", "");
+  top.string("description", "");
+  c.dim = static_cast<int>(top.integer("dimension", 2, 3));
+  c.density = top.number("density", Range::positive(), std::nullopt, "kg/m^3");
+  c.seed = static_cast<std::uint64_t>(
+      top.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), 1));
+  {
+    JsonObject g = top.object("grains");
+    if (g.has("radius") == g.has("sieve"))
+      top.fail("grains", "give exactly one of 'radius' [R_min, R_max] or 'sieve'");
+    if (g.has("radius")) {
+      const auto& r = g.raw("radius");
+      if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number())
+        g.fail("radius", "expected [R_min, R_max] in m, got " + describe(r));
+      c.r_min = r[0].get<double>();
+      c.r_max = r[1].get<double>();
+      if (!(c.r_min > 0))
+        g.fail("radius", "R_min = " + r[0].dump() + " is out of range (0, +inf) m");
+      if (c.r_min > c.r_max)
+        g.fail("radius", "R_min = " + r[0].dump() + " exceeds R_max = " + r[1].dump());
+    } else {
+      const auto& sv = g.raw("sieve");
+      if (!sv.is_array() || sv.size() < 2)
+        g.fail("sieve", "expected at least two [diameter m, fraction passing] pairs");
+      double last_d = 0, last_f = 0;
+      for (const auto& e : sv) {
+        if (!e.is_array() || e.size() != 2 || !e[0].is_number() || !e[1].is_number())
+          g.fail("sieve", "expected [diameter m, fraction passing] pairs, got " + describe(e));
+        const double d = e[0].get<double>(), f = e[1].get<double>();
+        if (!(d > last_d) || f < last_f || f > 1)
+          g.fail("sieve", "diameters must increase and fractions passing rise within [0, 1]");
+        c.sieve.emplace_back(d, f);
+        last_d = d;
+        last_f = f;
+      }
+      if (c.sieve.front().second != 0 || c.sieve.back().second != 1)
+        g.fail("sieve", "the curve must start at fraction 0 and end at fraction 1");
+      c.r_min = 0.5 * c.sieve.front().first;
+      c.r_max = 0.5 * c.sieve.back().first;
+    }
+    g.finish();
+  }
+  c.porosity = top.number("porosity", {0, 1, true, true}, std::nullopt);
+  c.vessel = read_shape(top.object("specimen"), c.dim);
+  if (top.has("cut"))
+    c.cut = read_shape(top.object("cut"), c.dim);
+  {
+    JsonObject p = top.object("packing");
+    c.cloud_porosity = p.number("cloud_porosity", {0, 1, true, true}, 0.5);
+    if (c.cloud_porosity <= c.porosity)
+      p.fail("cloud_porosity", "must exceed the target porosity " + std::to_string(c.porosity));
+    c.max_overlap_ratio = p.number("max_overlap_ratio", Range::positive(), 0.25);
+    c.equilibrium_ratio = p.number("equilibrium_ratio", Range::positive(), 1e-3);
+    c.max_cycles =
+        p.integer("max_cycles", 1000, std::numeric_limits<std::int64_t>::max(), 2'000'000);
+    c.eliminate_floaters = p.boolean("eliminate_floaters", false);
+    p.finish();
+  }
+  {
+    JsonObject i = top.object("installation");
+    c.pressure = i.number("pressure", Range::positive(), 1e5, "Pa");
+    c.pressure_tolerance = i.number("pressure_tolerance", {0, 1, true, true}, 0.01);
+    if (i.has("gap") && i.has("gap_ratio"))
+      i.fail("gap", "give either 'gap' (m) or 'gap_ratio' (g_i / R_avg), not both");
+    if (i.has("gap_ratio"))
+      c.install_gap =
+          i.number("gap_ratio", Range::non_negative(), std::nullopt) * 0.5 * (c.r_min + c.r_max);
+    else
+      c.install_gap = i.number("gap", Range::non_negative(), 0.0, "m");
+    c.residual_tolerance = i.number("residual_tolerance", Range::positive(), 0.05);
+    i.finish();
+  }
+  c.linear = read_linear(top.object("linear"));
+  const int bonds = top.has("flatjoint") + top.has("parallelbond");
+  if (bonds > 1)
+    top.fail("flatjoint", "give one of 'flatjoint' or 'parallelbond'");
+  if (top.has("flatjoint")) {
+    c.bonding = MaterialCard::Bonding::FlatJoint;
+    JsonObject f = top.object("flatjoint");
+    c.fj.fj_Nr = static_cast<int>(f.integer("fj_Nr", 1, 1000, c.dim == 2 ? 4 : 2));
+    if (c.dim == 3)
+      c.fj.fj_Nal = static_cast<int>(f.integer("fj_Nal", 3, 1000, 4));
+    c.fj.fj_rmul = f.number("fj_rmul", Range::positive(), 1.0);
+    c.fj.fj_emod = f.number("fj_emod", Range::positive(), std::nullopt, "Pa");
+    c.fj.fj_kratio = f.number("fj_kratio", Range::non_negative(), std::nullopt);
+    c.fj.fj_fric = f.number("fj_fric", Range::non_negative(), 0.0);
+    c.fj.fj_fa = f.number("fj_fa", Range::half_open(0, 90), 0.0, "deg");
+    c.fj_ten = read_dist(f, "fj_ten", "Pa");
+    c.fj_coh = read_dist(f, "fj_coh", "Pa");
+    c.fj.fj_exact = f.boolean("fj_exact", false);
+    JsonObject t = f.object("types");
+    c.frac_bonded = t.number("bonded", Range::closed(0, 1), 1.0);
+    c.frac_gapped = t.number("gapped", Range::closed(0, 1), 0.0);
+    c.frac_slit = t.number("slit", Range::closed(0, 1), 0.0);
+    if (std::abs(c.frac_bonded + c.frac_gapped + c.frac_slit - 1) > 1e-9)
+      t.fail("bonded", "the fractions bonded + gapped + slit must sum to 1 (they sum to " +
+                           std::to_string(c.frac_bonded + c.frac_gapped + c.frac_slit) + ")");
+    if (c.frac_gapped > 0)
+      c.gapped_gap = read_dist(t, "gap", "m");
+    t.finish();
+    f.finish();
+  } else if (top.has("parallelbond")) {
+    c.bonding = MaterialCard::Bonding::ParallelBond;
+    JsonObject p = top.object("parallelbond");
+    c.pb.pb_rmul = p.number("pb_rmul", Range::positive(), 1.0);
+    c.pb.pb_emod = p.number("pb_emod", Range::positive(), std::nullopt, "Pa");
+    c.pb.pb_kratio = p.number("pb_kratio", Range::non_negative(), std::nullopt);
+    c.pb.pb_mcf = p.number("pb_mcf", Range::closed(0, 1), 1.0);
+    c.pb.pb_fa = p.number("pb_fa", Range::half_open(0, 90), 0.0, "deg");
+    c.pb_ten = read_dist(p, "pb_ten", "Pa");
+    c.pb_coh = read_dist(p, "pb_coh", "Pa");
+    p.finish();
+  } else {
+    c.bonding = MaterialCard::Bonding::None;
+  }
+  for (const auto& [jj, jpath] : top.array("joints", false)) {
+    JsonObject j(*jj, path, jpath);
+    JointSpec js;
+    js.point = j.vec("point", c.dim, Vec3::Zero());
+    js.dip = j.number("dip", Range::closed(0, 360), std::nullopt, "deg");
+    js.ddir = c.dim == 3 ? j.number("ddir", Range::closed(0, 360), 0.0, "deg") : 0.0;
+    js.spacing = j.number("spacing", Range::non_negative(), 0.0, "m");
+    js.props.sj_kn = j.number("sj_kn", Range::non_negative(), std::nullopt, "Pa/m");
+    js.props.sj_ks = j.number("sj_ks", Range::non_negative(), std::nullopt, "Pa/m");
+    js.props.sj_fric = j.number("sj_fric", Range::non_negative(), 0.0);
+    js.props.sj_da = j.number("sj_da", Range::half_open(0, 90), 0.0, "deg");
+    js.props.bond = j.boolean("bonded", false);
+    js.props.bond_gap_hi = 1e300; // the joint replaces existing contacts whatever their gap
+    js.props.sj_ten = j.number("sj_ten", Range::non_negative(), 0.0, "Pa");
+    js.props.sj_coh = j.number("sj_coh", Range::non_negative(), 0.0, "Pa");
+    js.props.sj_fa = j.number("sj_fa", Range::half_open(0, 90), 0.0, "deg");
+    js.props.dip = js.dip;
+    js.props.ddir = js.ddir;
+    j.finish();
+    c.joints.push_back(js);
+  }
+  top.finish();
+  return c;
+}
+
+} // namespace rocklab

@@ -1,0 +1,81 @@
+// Material card: what a specimen is made of and how it is made (docs/material-format.md).
+// All quantities SI.
+#pragma once
+
+#include "contact/registry.hpp"
+#include "core/types.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rocklab {
+
+/// A property drawn per contact from Normal(mean, sd), clamped at zero.
+struct Distribution {
+  double mean = 0, sd = 0;
+};
+
+enum class SpecimenShape { Rectangle, Disk2D, Prism, Cylinder, Disk3D };
+
+struct ShapeSpec {
+  SpecimenShape shape = SpecimenShape::Prism;
+  Vec3 size = Vec3::Zero(); ///< rectangle/prism: edge lengths; cylinder: (D, H, 0); disks: (D,
+                            ///< thickness or 0, 0) [m]
+  double volume(int dim) const;
+  bool contains(const Vec3& x, double margin = 0) const; ///< x relative to the shape centre
+};
+
+/// A planar joint (or a set of parallel ones) inserted as smooth joints.
+struct JointSpec {
+  Vec3 point = Vec3::Zero(); ///< a point on the (first) plane, relative to the specimen centre [m]
+  double dip = 0, ddir = 0;  ///< [deg]
+  double spacing = 0;        ///< > 0: a set of planes this far apart [m]
+  SmoothJointProps props;    ///< bonded via props.bond
+};
+
+struct MaterialCard {
+  std::string file, name, source, text_hash;
+  nlohmann::json raw;
+  int dim = 3;
+  double density = 2650;       ///< grain density [kg/m^3]
+  double r_min = 0, r_max = 0; ///< uniform radius range [m]
+  std::vector<std::pair<double, double>>
+      sieve; ///< (diameter [m], mass fraction passing), ascending
+  double porosity = 0.36;
+  ShapeSpec vessel;             ///< the packed block
+  std::optional<ShapeSpec> cut; ///< test shape cut from the block
+  std::uint64_t seed = 1;
+  // packing
+  double cloud_porosity = 0.5;
+  double max_overlap_ratio = 0.25;
+  double equilibrium_ratio = 1e-3; ///< mean unbalanced-force ratio for "at rest"
+  std::int64_t max_cycles = 2'000'000;
+  // installation
+  double pressure = 1e5; ///< material-genesis (installation) pressure [Pa]
+  double pressure_tolerance = 0.01;
+  double install_gap = 0; ///< g_i [m]
+  // contacts
+  LinearProps linear; ///< grain-wall, non-bonded and new contacts
+  enum class Bonding { FlatJoint, ParallelBond, None } bonding = Bonding::FlatJoint;
+  FlatJointProps fj;
+  Distribution fj_ten, fj_coh;
+  double frac_bonded = 1, frac_gapped = 0, frac_slit = 0;
+  Distribution gapped_gap; ///< g_o of gapped contacts [m]
+  PBondProps pb;
+  Distribution pb_ten, pb_coh;
+  // release
+  double residual_tolerance = 0.05; ///< mean residual stress / pressure after release
+  bool eliminate_floaters = false;
+  std::vector<JointSpec> joints;
+};
+
+/// Read and validate a material card; errors name the file, key, value and allowed range.
+MaterialCard load_material_card(const std::string& path);
+
+/// FNV-1a 64-bit hash of a text, as 16 hex digits (stable across platforms).
+std::string text_hash(const std::string& text);
+
+} // namespace rocklab
