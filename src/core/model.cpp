@@ -13,6 +13,9 @@ namespace rocklab {
 namespace {
 
 constexpr std::size_t kBlock = 2048; // fixed reduction block: sums do not depend on threads
+// Loops shorter than this run on the calling thread: forking costs more than it saves, and on a
+// busy machine a barrier can cost a whole scheduler time slice. Results do not depend on it.
+constexpr std::size_t kParallelMin = 1024;
 
 /// Sum K quantities over n items in fixed blocks, so the result is bit-identical at any thread
 /// count. f(i, acc) adds item i's contributions into acc[0..K).
@@ -30,7 +33,7 @@ template <int K, class F> std::array<double, K> block_sum(std::size_t n, F&& f) 
     heap_parts.resize(nblocks);
     parts = heap_parts.data();
   }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (std::size_t b = 0; b < nblocks; ++b) {
     std::array<double, K> acc{};
     const std::size_t end = std::min(n, (b + 1) * kBlock);
@@ -159,7 +162,7 @@ void Model::detect() {
       }
     }
 
-#pragma omp parallel
+#pragma omp parallel if (n >= kParallelMin)
     {
       const std::size_t tid = static_cast<std::size_t>(omp_get_thread_num());
       std::vector<std::uint64_t>& keys = thread_keys_[tid];
@@ -361,7 +364,7 @@ void Model::force_displacement(double dt) {
   for (auto& buf : thread_events_)
     buf.clear();
 
-#pragma omp parallel reduction(min : blowup)
+#pragma omp parallel reduction(min : blowup) if (nc >= kParallelMin)
   {
     EventBuffer& events = thread_events_[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(static)
@@ -471,7 +474,7 @@ void Model::force_displacement(double dt) {
   // Sum contact forces into balls, each ball over its contacts in contact order.
   const std::size_t n = balls.size();
   double dt_min = std::numeric_limits<double>::infinity();
-#pragma omp parallel for schedule(static) reduction(min : dt_min)
+#pragma omp parallel for schedule(static) reduction(min : dt_min) if (n >= kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
     Vec3 F = Vec3::Zero(), M = Vec3::Zero();
     double k_tran = 0, k_rot = 0;
@@ -607,8 +610,9 @@ void Model::law_of_motion(double dt) {
 
   const std::size_t n = balls.size();
 #pragma omp parallel for schedule(static) reduction(max                                            \
-                                                    : vmax, dmax, step_ratio) reduction(||         \
-                                                                                        : bad)
+                                                    : vmax, dmax, step_ratio)                      \
+    reduction(||                                                                                   \
+              : bad) if (n >= kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
     vmax = std::max(vmax, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
     step_ratio = std::max(step_ratio, balls.vel[i].norm() * dt / balls.radius[i]);
