@@ -11,8 +11,20 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <unistd.h>
 
 namespace rocklab::test {
+
+/// A scratch folder of this test process, so concurrent test runs never share files.
+inline std::filesystem::path scratch_root() {
+  static const std::filesystem::path root = [] {
+    const auto p =
+        std::filesystem::temp_directory_path() / ("rocklab-tests-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(p);
+    return p;
+  }();
+  return root;
+}
 
 /// |a - b| <= rel * max(|b|, floor): the one relative-tolerance check used by the tests.
 inline ::testing::AssertionResult near_rel(double a, double b, double rel, double floor = 0.0) {
@@ -74,8 +86,9 @@ inline std::string read_file(const std::filesystem::path& p) {
 
 /// Run a shell command, capturing stderr+stdout into `output`; returns the exit status.
 inline int run_command(const std::string& cmd, std::string* output = nullptr) {
+  static int counter = 0;
   const std::filesystem::path log =
-      std::filesystem::temp_directory_path() / ("rocklab-cmd-" + std::to_string(::rand()) + ".log");
+      rocklab::test::scratch_root() / ("cmd-" + std::to_string(counter++) + ".log");
   const int rc = std::system((cmd + " > " + log.string() + " 2>&1").c_str());
   if (output)
     *output = read_file(log);

@@ -466,8 +466,7 @@ TEST(SmoothJoint, BlockOnAnInclinedJointSlidesAtTheCoulombLimit) {
 }
 
 TEST(SmoothJoint, InheritsSurfacePropertiesInSeries) {
-  const std::filesystem::path file =
-      std::filesystem::temp_directory_path() / "rocklab-inherit.json";
+  const std::filesystem::path file = rocklab::test::scratch_root() / "rocklab-inherit.json";
   std::ofstream(file) << R"({
     "dimension": 3,
     "balls": [{"id": 1, "position": [0, 0, 0], "radius": 0.005, "density": 2650, "group": "a"},

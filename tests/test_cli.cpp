@@ -11,12 +11,12 @@ using rocklab::test::source_dir;
 
 namespace {
 fs::path scratch(const std::string& name) {
-  const fs::path p = fs::temp_directory_path() / ("rocklab-test-" + name);
+  const fs::path p = rocklab::test::scratch_root() / ("rocklab-test-" + name);
   fs::remove_all(p);
   return p;
 }
 fs::path write_scene(const std::string& name, const std::string& text) {
-  const fs::path p = fs::temp_directory_path() / ("rocklab-scene-" + name + ".json");
+  const fs::path p = rocklab::test::scratch_root() / ("rocklab-scene-" + name + ".json");
   std::ofstream(p) << text;
   return p;
 }

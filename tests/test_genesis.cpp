@@ -15,7 +15,7 @@ std::string card(const char* name) {
   return test::source_dir() + "/tests/data/" + name;
 }
 fs::path scratch(const std::string& n) {
-  const fs::path p = fs::temp_directory_path() / ("rocklab-gen-" + n);
+  const fs::path p = rocklab::test::scratch_root() / ("rocklab-gen-" + n);
   fs::remove(p);
   fs::remove(p.string() + ".report.json");
   return p;
@@ -69,7 +69,7 @@ TEST(Genesis, SameSeedSameBytesAtAnyThreadCountAndRoundTrip) {
   // Another seed gives another packing.
   std::string text = test::read_file(card("genesis_2d_rect.json"));
   text.replace(text.find("\"seed\": 3"), 9, "\"seed\": 4");
-  const fs::path other = fs::temp_directory_path() / "rocklab-gen-seed4.json";
+  const fs::path other = rocklab::test::scratch_root() / "rocklab-gen-seed4.json";
   std::ofstream(other) << text;
   ASSERT_EQ(test::run_command(
                 test::binary() + " genesis " + other.string() + " -q -o " + c.string(), &out),
@@ -99,7 +99,7 @@ TEST(Genesis, BadCardsFailClearlyAndWriteNothing) {
         Case{"\"slit\": 0.1", "\"slit\": 0.2", "must sum to 1"}}) {
     std::string text = base;
     text.replace(text.find(k.from), std::string(k.from).size(), k.to);
-    const fs::path cardfile = fs::temp_directory_path() / "rocklab-bad-card.json";
+    const fs::path cardfile = rocklab::test::scratch_root() / "rocklab-bad-card.json";
     std::ofstream(cardfile) << text;
     const fs::path out = scratch("bad.rlspec");
     std::string msg;

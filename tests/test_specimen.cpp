@@ -65,7 +65,7 @@ TEST(Specimen, RoundTripContinuesBitForBit) {
   ASSERT_GT(a->batches().flatjoint.size(), 0u);
   ASSERT_GT(a->batches().pbond.size(), 0u);
   ASSERT_GT(a->batches().smoothjoint.size(), 0u);
-  const fs::path file = fs::temp_directory_path() / "rocklab-roundtrip.rlspec";
+  const fs::path file = rocklab::test::scratch_root() / "rocklab-roundtrip.rlspec";
   save_model(*a, file.string(), {{"note", "test"}});
   nlohmann::json meta;
   std::unique_ptr<Model> b = load_model(file.string(), &meta);
@@ -76,14 +76,14 @@ TEST(Specimen, RoundTripContinuesBitForBit) {
   EXPECT_EQ(state(*a), state(*b));
   EXPECT_EQ(a->step(), b->step());
   // Saving the restored model gives the same bytes.
-  const fs::path again = fs::temp_directory_path() / "rocklab-roundtrip-2.rlspec";
+  const fs::path again = rocklab::test::scratch_root() / "rocklab-roundtrip-2.rlspec";
   std::unique_ptr<Model> c = load_model(file.string());
   save_model(*c, again.string(), {{"note", "test"}});
   EXPECT_EQ(test::read_file(file), test::read_file(again));
 }
 
 TEST(Specimen, BadFilesFailCleanly) {
-  const fs::path dir = fs::temp_directory_path();
+  const fs::path dir = rocklab::test::scratch_root();
   EXPECT_THROW(load_model((dir / "does-not-exist.rlspec").string()), InputError);
   const fs::path notjson = dir / "rocklab-notjson.rlspec";
   std::ofstream(notjson) << "hello\n";

@@ -226,9 +226,7 @@ void Model::detect() {
   };
   auto retire = [&](std::size_t ci) {
     const Contact& c = contacts_[ci];
-    ContactEnergy e = contact_energy(batches_, c.model, c.slot);
-    e.strain = e.bond_strain = 0; // stored energy leaves with the contact
-    retired_ += e;
+    retire_dissipation(c);
     Event ev;
     ev.type = EventType::ContactDeleted;
     ev.step = step_;
@@ -328,7 +326,16 @@ void Model::detect() {
   std::swap(outputs_, new_outputs_);
   std::swap(batches_, new_batches_);
 
+  rebuild_adjacency();
+  for (auto& d : balls.disp)
+    d.setZero();
+  max_ball_disp_ = 0;
+  wall_disp_ = 0;
+}
+
+void Model::rebuild_adjacency() {
   // Ball -> contact adjacency in contact order, for a deterministic force sum.
+  const std::size_t n = balls.size();
   adj_start_.assign(n + 1, 0);
   for (const Contact& c : contacts_) {
     ++adj_start_[static_cast<std::size_t>(c.end1) + 1];
@@ -350,10 +357,13 @@ void Model::detect() {
             static_cast<std::int32_t>(2 * ci + 1);
     }
   }
-  for (auto& d : balls.disp)
-    d.setZero();
-  max_ball_disp_ = 0;
-  wall_disp_ = 0;
+}
+
+void Model::retire_dissipation(const Contact& c) {
+  // Dissipation so far stays in the ledger; stored energy leaves with the contact.
+  ContactEnergy e = contact_energy(batches_, c.model, c.slot);
+  e.strain = e.bond_strain = 0;
+  retired_ += e;
 }
 
 void Model::force_displacement(double dt) {
@@ -795,9 +805,7 @@ void Model::remove_walls(const std::vector<bool>& remove) {
     Contact c = contacts_[ci];
     if (c.kind == ContactKind::BallFacet) {
       if (remove[static_cast<std::size_t>(c.end2)]) {
-        ContactEnergy e = contact_energy(batches_, c.model, c.slot);
-        e.strain = e.bond_strain = 0;
-        retired_ += e;
+        retire_dissipation(c);
         continue;
       }
       c.end2 = map[static_cast<std::size_t>(c.end2)];
@@ -821,10 +829,7 @@ void Model::remove_walls(const std::vector<bool>& remove) {
 
 void Model::replace_contact_model(std::size_t ci, const ModelProps& props) {
   Contact& c = contacts_[ci];
-  // Dissipation so far stays in the ledger; the old data is dropped at the next compaction.
-  ContactEnergy e = contact_energy(batches_, c.model, c.slot);
-  e.strain = e.bond_strain = 0;
-  retired_ += e;
+  retire_dissipation(c); // the old data is dropped at the next compaction
   CreationInfo info;
   info.dim = settings.dim;
   info.R1 = balls.radius[static_cast<std::size_t>(c.end1)];
@@ -864,9 +869,7 @@ void Model::remove_balls(const std::vector<bool>& remove) {
     const bool bb = c.kind == ContactKind::BallBall;
     if (remove[static_cast<std::size_t>(c.end1)] ||
         (bb && remove[static_cast<std::size_t>(c.end2)])) {
-      ContactEnergy e = contact_energy(batches_, c.model, c.slot);
-      e.strain = e.bond_strain = 0;
-      retired_ += e;
+      retire_dissipation(c);
       continue;
     }
     c.end1 = map[static_cast<std::size_t>(c.end1)];

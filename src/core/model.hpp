@@ -97,6 +97,8 @@ public:
 
 private:
   void ensure_thread_buffers();
+  void rebuild_adjacency();
+  void retire_dissipation(const Contact& c);
   void detect();
   void force_displacement(double dt_increment);
   void law_of_motion(double dt);

@@ -223,27 +223,12 @@ template <class A> void Model::serialize(A& a) {
   if constexpr (A::reading) {
     if (outputs_.size() != contacts_.size())
       throw InputError("corrupt specimen body (contact arrays of different lengths)");
-    // Rebuild the ball -> contact adjacency (derived data) exactly as detection would.
-    adj_start_.assign(n + 1, 0);
-    for (const Contact& c : contacts_) {
-      if (c.end1 < 0 || static_cast<std::size_t>(c.end1) >= n)
+    for (const Contact& c : contacts_)
+      if (c.end1 < 0 || static_cast<std::size_t>(c.end1) >= n ||
+          (c.kind == ContactKind::BallBall &&
+           (c.end2 < 0 || static_cast<std::size_t>(c.end2) >= n)))
         throw InputError("corrupt specimen body (contact end out of range)");
-      ++adj_start_[static_cast<std::size_t>(c.end1) + 1];
-      if (c.kind == ContactKind::BallBall)
-        ++adj_start_[static_cast<std::size_t>(c.end2) + 1];
-    }
-    for (std::size_t i = 0; i < n; ++i)
-      adj_start_[i + 1] += adj_start_[i];
-    adj_items_.resize(static_cast<std::size_t>(adj_start_[n]));
-    adj_cursor_.assign(adj_start_.begin(), adj_start_.end() - 1);
-    for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
-      const Contact& c = contacts_[ci];
-      adj_items_[static_cast<std::size_t>(adj_cursor_[static_cast<std::size_t>(c.end1)]++)] =
-          static_cast<std::int32_t>(2 * ci);
-      if (c.kind == ContactKind::BallBall)
-        adj_items_[static_cast<std::size_t>(adj_cursor_[static_cast<std::size_t>(c.end2)]++)] =
-            static_cast<std::int32_t>(2 * ci + 1);
-    }
+    rebuild_adjacency(); // derived data, exactly as detection builds it
   }
 }
 
