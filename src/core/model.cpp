@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <omp.h>
 #include <sstream>
@@ -798,26 +799,14 @@ void Model::remove_walls(const std::vector<bool>& remove) {
       map[w] = static_cast<std::int32_t>(kept.size());
       kept.push_back(walls[w]);
     }
-  new_contacts_.clear();
-  new_outputs_.clear();
-  new_batches_.clear();
-  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
-    Contact c = contacts_[ci];
+  compact_contacts([&](Contact& c) {
     if (c.kind == ContactKind::BallFacet) {
-      if (remove[static_cast<std::size_t>(c.end2)]) {
-        retire_dissipation(c);
-        continue;
-      }
+      if (remove[static_cast<std::size_t>(c.end2)])
+        return false;
       c.end2 = map[static_cast<std::size_t>(c.end2)];
-      c.key = contact_key(c.kind, c.end1, c.end2);
     }
-    c.slot = move_contact_data(new_batches_, batches_, c.model, c.slot);
-    new_contacts_.push_back(c);
-    new_outputs_.push_back(outputs_[ci]);
-  }
-  std::swap(contacts_, new_contacts_);
-  std::swap(outputs_, new_outputs_);
-  std::swap(batches_, new_batches_);
+    return true;
+  });
   walls = std::move(kept);
   for (ModelRule& r : rules)
     if (r.wall >= 0) // a rule for a removed wall never matches again (-2)
@@ -825,6 +814,28 @@ void Model::remove_walls(const std::vector<bool>& remove) {
           map[static_cast<std::size_t>(r.wall)] >= 0 ? map[static_cast<std::size_t>(r.wall)] : -2;
   if (initialized_)
     detect();
+}
+
+void Model::compact_contacts(const std::function<bool(Contact&)>& keep) {
+  // Keep (and let `keep` renumber) some contacts in their order; the dropped ones retire their
+  // dissipation. Model data is compacted into fresh batches.
+  new_contacts_.clear();
+  new_outputs_.clear();
+  new_batches_.clear();
+  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+    Contact c = contacts_[ci];
+    if (!keep(c)) {
+      retire_dissipation(contacts_[ci]);
+      continue;
+    }
+    c.key = contact_key(c.kind, c.end1, c.end2);
+    c.slot = move_contact_data(new_batches_, batches_, c.model, c.slot);
+    new_contacts_.push_back(c);
+    new_outputs_.push_back(outputs_[ci]);
+  }
+  std::swap(contacts_, new_contacts_);
+  std::swap(outputs_, new_outputs_);
+  std::swap(batches_, new_batches_);
 }
 
 void Model::replace_contact_model(std::size_t ci, const ModelProps& props) {
@@ -861,28 +872,16 @@ void Model::remove_balls(const std::vector<bool>& remove) {
   compact(balls.disp), compact(balls.radius), compact(balls.mass), compact(balls.inertia);
   compact(balls.density), compact(balls.fixity), compact(balls.group), compact(balls.id);
   // Contacts of removed balls go; the others keep their order (the index map is monotonic).
-  new_contacts_.clear();
-  new_outputs_.clear();
-  new_batches_.clear();
-  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
-    Contact c = contacts_[ci];
+  compact_contacts([&](Contact& c) {
     const bool bb = c.kind == ContactKind::BallBall;
     if (remove[static_cast<std::size_t>(c.end1)] ||
-        (bb && remove[static_cast<std::size_t>(c.end2)])) {
-      retire_dissipation(c);
-      continue;
-    }
+        (bb && remove[static_cast<std::size_t>(c.end2)]))
+      return false;
     c.end1 = map[static_cast<std::size_t>(c.end1)];
     if (bb)
       c.end2 = map[static_cast<std::size_t>(c.end2)];
-    c.key = contact_key(c.kind, c.end1, c.end2);
-    c.slot = move_contact_data(new_batches_, batches_, c.model, c.slot);
-    new_contacts_.push_back(c);
-    new_outputs_.push_back(outputs_[ci]);
-  }
-  std::swap(contacts_, new_contacts_);
-  std::swap(outputs_, new_outputs_);
-  std::swap(batches_, new_batches_);
+    return true;
+  });
   if (initialized_)
     detect(); // rebuilds the adjacency; new candidates may appear
 }

@@ -10,6 +10,7 @@
 #include "core/walls.hpp"
 
 #include <array>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -99,6 +100,7 @@ private:
   void ensure_thread_buffers();
   void rebuild_adjacency();
   void retire_dissipation(const Contact& c);
+  void compact_contacts(const std::function<bool(Contact&)>& keep);
   void detect();
   void force_displacement(double dt_increment);
   void law_of_motion(double dt);
