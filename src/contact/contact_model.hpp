@@ -70,6 +70,14 @@ struct EventSink {
     e.seq = seq++;
     buffer->push_back(e);
   }
+  /// slip_change: mode 0 slip began, 1 slip ended; element 1..N for flat joints.
+  void slip_change(bool began, std::int32_t element = -1) noexcept {
+    Event e;
+    e.type = EventType::SlipChange;
+    e.mode = began ? 0 : 1;
+    e.element = element;
+    raise(e);
+  }
 };
 
 } // namespace rocklab

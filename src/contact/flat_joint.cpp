@@ -110,7 +110,6 @@ flatjoint::Moments flatjoint::clipped_moments(double r1, double r2, double a1, d
                                               double bs, double bt) {
   Moments m{};
   const double bn = std::hypot(bs, bt);
-  auto inside = [&](double s, double t) { return gs + s * bs + t * bt < 0; };
   if (bn == 0) {
     if (gs < 0) {
       add_arc(r2, a1, a2, m);
@@ -198,7 +197,6 @@ flatjoint::Moments flatjoint::clipped_moments(double r1, double r2, double a1, d
   } else {
     chord(u_lo, u_hi);
   }
-  (void)inside;
   return m;
 }
 
@@ -347,13 +345,8 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
   const double min_gap = c.gs - R * std::hypot(c.tbs, c.tbt);
   if (!any_bonded && min_gap >= 0) {
     for (auto& el : e) {
-      if (el.slip) {
-        Event ev;
-        ev.type = EventType::SlipChange;
-        ev.mode = 1;
-        ev.element = static_cast<int>(&el - e.data()) + 1;
-        events.raise(ev);
-      }
+      if (el.slip)
+        events.slip_change(false, static_cast<std::int32_t>(&el - e.data()) + 1);
       const double E_slip = el.E_slip;
       el = FlatJointElement{.E_slip = E_slip, .B = el.B};
     }
@@ -407,11 +400,7 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
     auto end_slip = [&]() {
       if (el.slip) {
         el.slip = false;
-        Event ev;
-        ev.type = EventType::SlipChange;
-        ev.mode = 1;
-        ev.element = static_cast<int>(i) + 1;
-        events.raise(ev);
+        events.slip_change(false, static_cast<std::int32_t>(i) + 1);
       }
     };
     auto raise_break = [&](int mode, double strength, double energy) {
@@ -433,9 +422,8 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
       raise_break(1, c.ten, energy);
       do_shear = false;
       // Step 3 with the now unbonded element (Fn stays zero as the memo prescribes).
-      const double Fn_keep = 0;
       normal_update(false);
-      el.Fn = Fn_keep;
+      el.Fn = 0;
     } else if (!bonded && sigma >= 0) {
       el.Fss = el.Fst = el.Mt = 0;
       end_slip();
@@ -472,11 +460,7 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
       el.Fst = Fst;
       if (slipping != el.slip) {
         el.slip = slipping;
-        Event ev;
-        ev.type = EventType::SlipChange;
-        ev.mode = slipping ? 0 : 1;
-        ev.element = static_cast<int>(i) + 1;
-        events.raise(ev);
+        events.slip_change(slipping, static_cast<std::int32_t>(i) + 1);
       }
     } else {
       const double tau_c = c.coh - sigma * c.tan_fa;

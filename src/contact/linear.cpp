@@ -59,10 +59,7 @@ void update_linear_part(const LinearParams& p, LinearState& s, const ContactKine
     s.E_slip -= 0.5 * ((F0ss + s.Fss) * dmu_ss + (F0st + s.Fst) * dmu_st);
   }
   if (slipping != s.slip) {
-    Event e;
-    e.type = EventType::SlipChange;
-    e.mode = slipping ? 0 : 1;
-    events.raise(e);
+    events.slip_change(slipping);
     s.slip = slipping;
   }
 }
@@ -73,12 +70,8 @@ void update(LinearContact& c, const ContactKinematics& k, ContactResult& out, Ev
   LinearState& s = c.s;
   const double gs = k.gap - p.rgap;
   const bool open = gs > 0.0;
-  if (open && s.slip) {
-    Event e;
-    e.type = EventType::SlipChange;
-    e.mode = 1;
-    events.raise(e);
-  }
+  if (open && s.slip)
+    events.slip_change(false);
   if (open) {
     // The linear interface is open: no linear force. The contact stays active only when a
     // bonded model says so, and then only its dashpots act.

@@ -99,10 +99,7 @@ void update(SmoothJointContact& c, const Vec3& d_delta, double gap, Vec3& force,
       c.Fs = trial;
     }
     if (slipping != c.slip) {
-      Event e;
-      e.type = EventType::SlipChange;
-      e.mode = slipping ? 0 : 1;
-      events.raise(e);
+      events.slip_change(slipping);
       c.slip = slipping;
     }
   };

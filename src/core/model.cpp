@@ -199,10 +199,7 @@ void Model::detect() {
           if ((xi.array() < wall.lo.array() - reach).any() ||
               (xi.array() > wall.hi.array() + reach).any())
             continue;
-          double dmin = std::numeric_limits<double>::max();
-          for (const Facet& f : wall.facets)
-            dmin = std::min(dmin, (closest_point_on_facet(f, xi) - xi).norm());
-          if (dmin < reach)
+          if ((wall.closest_point(xi) - xi).norm() < reach)
             keys.push_back(contact_key(ContactKind::BallFacet, static_cast<std::int32_t>(i),
                                        static_cast<std::int32_t>(w)));
         }
@@ -266,16 +263,8 @@ void Model::detect() {
     info.ball_facet = facet;
     const Vec3& x1 = balls.pos[end1];
     if (facet) {
-      double dmin = std::numeric_limits<double>::max();
-      Vec3 xf = x1;
-      for (const Facet& f : walls[static_cast<std::size_t>(end2)].facets) {
-        const Vec3 p = closest_point_on_facet(f, x1);
-        if ((p - x1).squaredNorm() < dmin) {
-          dmin = (p - x1).squaredNorm();
-          xf = p;
-        }
-      }
-      const PlaneGeometry g = ball_facet_plane(x1, info.R1, xf);
+      const PlaneGeometry g =
+          ball_facet_plane(x1, info.R1, walls[static_cast<std::size_t>(end2)].closest_point(x1));
       info.gap = g.gap;
       info.n = g.n;
     } else {
@@ -398,18 +387,7 @@ void Model::force_displacement(double dt) {
         m_eff = balls.mass[i1] * balls.mass[i2] / (balls.mass[i1] + balls.mass[i2]);
       } else {
         const Wall& wall = walls[static_cast<std::size_t>(c.end2)];
-        double dmin = std::numeric_limits<double>::max();
-        Vec3 xf = Vec3::Zero();
-        for (std::size_t f = 0; f < wall.facets.size(); ++f) {
-          const Vec3 p = closest_point_on_facet(wall.facets[f], x1);
-          const double d = (p - x1).squaredNorm();
-          if (d < dmin) {
-            dmin = d;
-            xf = p;
-            c.facet = static_cast<std::int32_t>(f);
-          }
-        }
-        g = ball_facet_plane(x1, R1, xf);
+        g = ball_facet_plane(x1, R1, wall.closest_point(x1, &c.facet));
         xb2 = wall.center;
         // A radially moving wall adds its radial speed at the contact point.
         v2 = wall.radial_velocity != 0

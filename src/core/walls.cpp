@@ -1,6 +1,7 @@
 #include "core/walls.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace rocklab {
 
@@ -75,6 +76,22 @@ Vec3 closest_on_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 } // namespace
+
+Vec3 Wall::closest_point(const Vec3& p, std::int32_t* facet) const {
+  double dmin = std::numeric_limits<double>::max();
+  Vec3 best = p;
+  for (std::size_t f = 0; f < facets.size(); ++f) {
+    const Vec3 q = closest_point_on_facet(facets[f], p);
+    const double d = (q - p).squaredNorm();
+    if (d < dmin) {
+      dmin = d;
+      best = q;
+      if (facet)
+        *facet = static_cast<std::int32_t>(f);
+    }
+  }
+  return best;
+}
 
 Vec3 closest_point_on_facet(const Facet& f, const Vec3& p) {
   if (f.nv == 2)

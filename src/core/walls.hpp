@@ -36,6 +36,8 @@ struct Wall {
   void move(double dt);
   /// Largest distance a vertex moves in one step of length dt [m].
   double max_vertex_speed() const;
+  /// The point of the wall closest to p (the first facet wins a tie); `facet` receives its index.
+  Vec3 closest_point(const Vec3& p, std::int32_t* facet = nullptr) const;
   /// Outward radial unit vector at p (zero on the axis).
   Vec3 radial_dir(const Vec3& p) const {
     Vec3 r = p - center;
