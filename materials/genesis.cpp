@@ -1,10 +1,13 @@
 #include "materials/genesis.hpp"
 
+#include "io/json_input.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 
 namespace rocklab {
@@ -58,24 +61,12 @@ Wall plane(int dim, const std::string& name, const Vec3& p, const Vec3& n, doubl
   return w;
 }
 
-// A circular (2D) or cylindrical (3D, axis z, from -h/2 to h/2) wall whose flat faces lie at
-// radius r (circumscribed polygon of n sides).
-Wall round_wall(int dim, double r, double h, int n) {
+// A circular (2D) or cylindrical (3D, axis z, unbounded along it) wall of radius r.
+Wall round_wall(double r) {
   Wall w;
   w.name = "vessel.lateral";
-  const double rv = r / std::cos(kPi / n);
-  for (int k = 0; k < n; ++k) {
-    const double a0 = 2 * kPi * k / n, a1 = 2 * kPi * (k + 1) / n;
-    const Vec3 p0(rv * std::cos(a0), rv * std::sin(a0), 0),
-        p1(rv * std::cos(a1), rv * std::sin(a1), 0);
-    if (dim == 2) {
-      w.facets.push_back(facet({p0, p1}));
-    } else {
-      const Vec3 lo(0, 0, -0.5 * h), hi(0, 0, 0.5 * h);
-      w.facets.push_back(facet({p0 + lo, p1 + lo, p1 + hi}));
-      w.facets.push_back(facet({p0 + lo, p1 + hi, p0 + hi}));
-    }
-  }
+  w.cylinder_radius = r;
+  w.half_height = 0;
   w.center = Vec3::Zero();
   w.axis = Vec3::UnitZ();
   w.update_bounds();
@@ -92,12 +83,7 @@ struct Vessel {
   int dim;
   SpecimenShape shape;
   std::vector<Servo> servos;
-  int sides = 0; // polygon sides of a round wall
-
-  double radius(const Model& m, const Servo& s) const {
-    const Vec3 v = m.walls[s.wall].facets[0].v[0];
-    return std::hypot(v.x(), v.y()) * std::cos(kPi / sides);
-  }
+  double radius(const Model& m, const Servo& s) const { return m.walls[s.wall].cylinder_radius; }
   // Current extent along axis a between the two planar walls normal to it.
   double extent(const Model& m, int axis) const {
     double lo = 0, hi = 0;
@@ -146,6 +132,10 @@ struct Vessel {
         a *= extent(m, d);
     return a;
   }
+  // Distance of a wall from the vessel centre (its radius for the round wall) [m].
+  double half_extent(const Model& m, const Servo& s) const {
+    return s.radial ? radius(m, s) : std::abs(m.walls[s.wall].center.dot(s.n_in));
+  }
   // Compressive stress on a wall [Pa].
   double stress(const Model& m, const Servo& s) const {
     const Wall& w = m.walls[s.wall];
@@ -154,11 +144,12 @@ struct Vessel {
   }
 };
 
-Vessel make_vessel(Model& m, const MaterialCard& card) {
+// The vessel of the card's specimen shape, every length multiplied by `scale`.
+Vessel make_vessel(Model& m, const MaterialCard& card, double scale) {
   Vessel v;
   v.dim = card.dim;
   v.shape = card.vessel.shape;
-  const Vec3 L = card.vessel.size;
+  const Vec3 L = card.vessel.size * scale;
   const double big = 1.5 * L.maxCoeff();
   auto add_plane = [&](const std::string& name, const Vec3& p, const Vec3& n) {
     m.walls.push_back(plane(card.dim, name, p, n, big));
@@ -180,9 +171,8 @@ Vessel make_vessel(Model& m, const MaterialCard& card) {
   case SpecimenShape::Disk2D:
   case SpecimenShape::Cylinder:
   case SpecimenShape::Disk3D: {
-    v.sides = card.dim == 2 ? 96 : 64;
     const double h = card.dim == 3 ? L.y() : 0;
-    m.walls.push_back(round_wall(card.dim, 0.5 * L.x(), 1.3 * h, v.sides));
+    m.walls.push_back(round_wall(0.5 * L.x()));
     v.servos.push_back({m.walls.size() - 1, Vec3::Zero(), true});
     if (card.dim == 3) {
       add_plane("vessel.bottom", Vec3(0, 0, -0.5 * h), Vec3::UnitZ());
@@ -259,7 +249,9 @@ nlohmann::json GenesisReport::to_json() const {
           {"floaters", floaters},
           {"porosity_target", porosity_target},
           {"porosity_packed", porosity_packed},
+          {"porosity_installed", porosity_installed},
           {"porosity", porosity},
+          {"packing_friction", packing_friction},
           {"coordination_number", coordination},
           {"contacts",
            {{"total", contacts},
@@ -280,7 +272,8 @@ nlohmann::json GenesisReport::to_json() const {
 }
 
 GenesisResult run_genesis(const MaterialCard& card,
-                          const std::function<void(const std::string&)>& progress) {
+                          const std::function<void(const std::string&)>& progress,
+                          const std::atomic<bool>* interrupt) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
   auto say = [&](const std::string& s) {
@@ -294,9 +287,9 @@ GenesisResult run_genesis(const MaterialCard& card,
   m.settings.dim = dim;
   m.settings.local_damping = 0.7;
   m.settings.gravity = Vec3::Zero();
+  m.settings.slip_events = false; // nobody reads them during genesis
   std::mt19937_64 rng(card.seed);
 
-  Vessel vessel = make_vessel(m, card);
   const double V0 = card.vessel.volume(dim);
   const std::vector<double> radii = sample_radii(card, (1 - card.porosity) * V0, rng);
   const double r_avg = [&] {
@@ -305,28 +298,36 @@ GenesisResult run_genesis(const MaterialCard& card,
       s += r;
     return s / static_cast<double>(radii.size());
   }();
-  // Cloud: the same grains shrunk to the cloud porosity, placed at random (overlaps allowed).
+  // The cloud is at the cloud porosity: boundary contraction puts the full-size grains into a
+  // vessel enlarged by 1/shrink; grain scaling shrinks the grains by `shrink` inside the vessel.
   const double shrink = std::pow((1 - card.cloud_porosity) / (1 - card.porosity), 1.0 / dim);
+  const bool contraction = card.packing_method == MaterialCard::Packing::Contraction;
+  const double vessel_scale = contraction ? 1.0 / shrink : 1.0;
+  const double grain_scale = contraction ? 1.0 : shrink;
+  Vessel vessel = make_vessel(m, card, vessel_scale);
   const int grains = m.group_index("grains");
+  const bool round = card.vessel.shape == SpecimenShape::Disk2D ||
+                     card.vessel.shape == SpecimenShape::Cylinder ||
+                     card.vessel.shape == SpecimenShape::Disk3D;
+  const Vec3& L = card.vessel.size;
+  const Vec3 half =
+      vessel_scale * (round ? Vec3(0.5 * L.x(), 0.5 * L.x(), dim == 3 ? 0.5 * L.y() : 0.0)
+                            : Vec3(0.5 * L.x(), 0.5 * L.y(), dim == 3 ? 0.5 * L.z() : 0.0));
   for (std::size_t i = 0; i < radii.size(); ++i) {
-    const double r = radii[i] * shrink;
+    const double r = radii[i] * grain_scale;
     // Uniform in the shape's bounding box, kept when the grain lies inside the shape.
-    const Vec3& L = card.vessel.size;
-    const bool round = card.vessel.shape == SpecimenShape::Disk2D ||
-                       card.vessel.shape == SpecimenShape::Cylinder ||
-                       card.vessel.shape == SpecimenShape::Disk3D;
-    const Vec3 half = round ? Vec3(0.5 * L.x(), 0.5 * L.x(), dim == 3 ? 0.5 * L.y() : 0.0)
-                            : Vec3(0.5 * L.x(), 0.5 * L.y(), dim == 3 ? 0.5 * L.z() : 0.0);
     Vec3 x = Vec3::Zero();
     for (int attempt = 0;; ++attempt) {
       for (int d = 0; d < dim; ++d)
         x[d] = (2 * uniform01(rng) - 1) * half[d];
-      if (card.vessel.contains(x, r) || attempt > 10000)
+      if (card.vessel.contains(x / vessel_scale, r / vessel_scale) || attempt > 10000)
         break;
     }
     m.balls.add(dim, static_cast<std::int64_t>(i + 1), x, r, card.density, grains);
   }
-  // Packing contacts: frictionless linear springs with the card's stiffness at the mean size.
+  // Packing contacts: linear springs with the card's stiffness at the mean size; frictionless
+  // for the cloud relaxation, then the packing friction between grains. Vessel walls stay
+  // frictionless.
   LinearProps pack;
   if (card.linear.emod > 0) {
     const double area = dim == 2 ? 2 * r_avg : kPi * r_avg * r_avg;
@@ -337,6 +338,17 @@ GenesisResult run_genesis(const MaterialCard& card,
     pack.ks = card.linear.ks;
   }
   pack.fric = 0;
+  // Compaction runs with springs soft enough that the pressure strains them by
+  // `compaction_strain` (the rearrangement takes ~sqrt(E*/p) steps, so stiff rock contacts
+  // would make it slow); the card's stiffness is installed once the porosity is locked.
+  const LinearProps stiff = pack;
+  {
+    const double area = dim == 2 ? 2 * r_avg : kPi * r_avg * r_avg;
+    const double e_equiv = pack.kn * 2 * r_avg / area;
+    const double f = std::min(1.0, card.pressure / (card.compaction_strain * e_equiv));
+    pack.kn *= f;
+    pack.ks *= f;
+  }
   ModelRule bb, bf;
   bb.props = pack;
   bf.ball_facet = true;
@@ -357,25 +369,28 @@ GenesisResult run_genesis(const MaterialCard& card,
                                  "' did not converge in " + std::to_string(card.max_cycles) +
                                  " cycles (key 'packing.max_cycles')");
       m.cycle(check);
+      m.clear_events();
+      if (interrupt && interrupt->load())
+        throw std::runtime_error("interrupted");
     }
     return m.step() - start;
   };
   say("relaxing the grain cloud");
   rep.steps_packing += run_until("cloud relaxation", 50,
                                  [&] { return max_overlap_ratio(m) <= card.max_overlap_ratio; });
-  // Grain scaling to the target porosity (deep overlaps right after scaling are expected too).
-  for (std::size_t i = 0; i < m.balls.size(); ++i)
-    m.balls.set_radius(i, radii[i], dim);
-  say("packing at the target porosity");
-  rep.steps_packing += run_until(
-      "packing", 50, [&] { return m.mean_unbalanced_force_ratio() <= card.equilibrium_ratio; });
-  rep.porosity_target = card.porosity;
-  rep.porosity_packed = 1 - grain_volume_sum(m) / vessel.volume(m);
-
-  // Installation: servo-controlled vessel walls reach the isotropic pressure.
+  if (!contraction)
+    for (std::size_t i = 0; i < m.balls.size(); ++i)
+      m.balls.set_radius(i, radii[i], dim);
   m.settings.overlap_check = true;
-  say("installing the isotropic stress");
+
+  // Servo control of every vessel wall toward a target stress: the wall speed closes half the
+  // stress error per step (0.5 A / (sum k dt) x error), capped so the vessel contracts at one
+  // strain rate (the cap is proportional to the wall's distance from the centre).
   const double p = card.pressure;
+  double largest_half = 0;
+  for (const Servo& s : vessel.servos)
+    largest_half = std::max(largest_half, vessel.half_extent(m, s));
+  double speed_cap = 0.01; // largest wall displacement per step / mean radius
   auto servo_step = [&](double target) {
     std::vector<double> ksum(m.walls.size(), 0.0);
     for (std::size_t ci = 0; ci < m.contacts().size(); ++ci)
@@ -383,8 +398,8 @@ GenesisResult run_genesis(const MaterialCard& card,
         ksum[static_cast<std::size_t>(m.contacts()[ci].end2)] +=
             m.contact_outputs()[ci].stiff.k_tran;
     const double dt = std::max(m.timestep(), 1e-12);
-    const double vmax = 0.01 * r_avg / dt;
     for (const Servo& s : vessel.servos) {
+      const double vmax = speed_cap * r_avg / dt * vessel.half_extent(m, s) / largest_half;
       const double err = target - vessel.stress(m, s); // > 0: push in
       const double A = vessel.area(m, s);
       double v = ksum[s.wall] > 0 ? 0.5 * A / (ksum[s.wall] * dt) * err : vmax;
@@ -396,32 +411,129 @@ GenesisResult run_genesis(const MaterialCard& card,
         w.velocity = v * s.n_in;
     }
   };
-  auto stresses_ok = [&](double target, double tol) {
+  auto stresses_within = [&](double target, double tol) {
     for (const Servo& s : vessel.servos)
       if (std::abs(vessel.stress(m, s) - target) > tol * target)
         return false;
     return true;
   };
+  auto porosity_now = [&] { return 1 - grain_volume_sum(m) / vessel.volume(m); };
+
+  // Compaction at the installation pressure with friction control (as in YADE's triaxial
+  // compaction): the servo-controlled walls compact grains with the packing friction; while
+  // the packing at pressure is looser than the target the friction is lowered step by step; at
+  // the target the packing friction locks the structure and the walls hold the pressure until
+  // equilibrium.
+  say("compacting to the target porosity at the installation pressure");
+  auto set_packing_friction = [&](double f) {
+    std::get<LinearProps>(m.rules[0].props).fric = f;
+    m.set_property(ModelKind::Linear, "fric", f, ContactSelect::BallBall);
+  };
+  auto install_card_stiffness = [&] {
+    LinearProps& b = std::get<LinearProps>(m.rules[0].props);
+    LinearProps& w = std::get<LinearProps>(m.rules[1].props);
+    b.kn = stiff.kn;
+    b.ks = stiff.ks;
+    w.kn = 2 * stiff.kn;
+    w.ks = 2 * stiff.ks;
+    m.set_property(ModelKind::Linear, "kn", b.kn, ContactSelect::BallBall);
+    m.set_property(ModelKind::Linear, "ks", b.ks, ContactSelect::BallBall);
+    m.set_property(ModelKind::Linear, "kn", w.kn, ContactSelect::BallFacet);
+    m.set_property(ModelKind::Linear, "ks", w.ks, ContactSelect::BallFacet);
+  };
   {
     const std::int64_t start = m.step();
-    std::int64_t since_check = 0;
+    const std::int64_t chunk = 100;
+    const double tol_n = card.porosity_tolerance;
+    bool frozen = false;
+    std::int64_t frozen_at = 0, window_at = m.step(), decrements = 0;
+    double mu = card.packing_friction;
+    set_packing_friction(mu);
+    double n_window = 1.0;
     for (;;) {
-      servo_step(p);
-      m.cycle(1);
-      if (++since_check >= 50) {
-        since_check = 0;
-        if (stresses_ok(p, card.pressure_tolerance) &&
-            m.mean_unbalanced_force_ratio() <= card.equilibrium_ratio)
-          break;
+      for (std::int64_t k = 0; k < chunk; ++k) {
+        servo_step(p);
+        m.cycle(1);
       }
+      m.clear_events();
+      if (interrupt && interrupt->load())
+        throw std::runtime_error("interrupted");
+      const double n = porosity_now();
+      const double ratio = m.mean_unbalanced_force_ratio();
+      const bool settled =
+          stresses_within(p, card.pressure_tolerance) && ratio <= card.equilibrium_ratio;
+      // Frictionless compaction has stalled when, at pressure, the porosity moved less than a
+      // twentieth of the tolerance over the last 5000 steps.
+      bool stalled = false;
+      if (m.step() - window_at >= 5000) {
+        stalled = stresses_within(p, 0.05) && n_window - n < 0.05 * tol_n;
+        n_window = n;
+        window_at = m.step();
+      }
+      if ((m.step() - start) % 5000 < chunk) {
+        std::ostringstream msg;
+        msg << (frozen ? "installing" : "compacting") << ": step " << m.step() << ", porosity " << n
+            << ", unbalanced-force ratio " << ratio << ", wall stresses [Pa]";
+        for (const Servo& s : vessel.servos)
+          msg << " " << vessel.stress(m, s);
+        say(msg.str());
+      }
+      const bool at_pressure = stresses_within(p, 0.1);
+      if (!frozen && n <= card.porosity + 0.25 * tol_n && at_pressure) {
+        // Target reached: lock the structure with the packing friction so that it stops
+        // creeping toward its frictionless density; the grains come to rest in the held vessel,
+        // then the walls hold the pressure.
+        if (decrements == 0 && n < card.porosity - tol_n) {
+          std::ostringstream msg;
+          msg << card.file << ": key 'porosity': the target " << card.porosity
+              << " is looser than the porosity " << n << " that a packing with friction "
+              << card.packing_friction
+              << " reaches at the installation pressure; raise 'packing.friction'";
+          throw InputError(msg.str());
+        }
+        frozen = true;
+        frozen_at = m.step();
+        rep.porosity_packed = n;
+        rep.packing_friction = mu;
+        set_packing_friction(card.packing_friction);
+        install_card_stiffness();
+        for (std::size_t i = 0; i < m.balls.size(); ++i) {
+          m.balls.vel[i].setZero();
+          m.balls.spin[i].setZero();
+        }
+        for (Wall& w : m.walls) {
+          w.velocity.setZero();
+          w.radial_velocity = 0;
+        }
+        run_until("settling the locked packing", 50,
+                  [&] { return m.mean_unbalanced_force_ratio() <= 1e-2; });
+        speed_cap = 0.001;
+      } else if (!frozen && at_pressure && mu > 0 && n > card.porosity) {
+        // Too loose at pressure: lower the grain friction a little (the packing follows).
+        mu = mu > 0.01 * card.packing_friction ? 0.97 * mu : 0.0;
+        set_packing_friction(mu);
+        ++decrements;
+      } else if (!frozen && mu == 0 && (settled || stalled)) {
+        std::ostringstream msg;
+        msg << card.file << ": key 'porosity': the target " << card.porosity
+            << " is below the porosity " << n
+            << " that a frictionless packing of these grains reaches at the installation "
+               "pressure in this vessel; raise the target or widen the size distribution";
+        throw InputError(msg.str());
+      }
+      if (frozen && settled)
+        break;
       if (m.step() - start > card.max_cycles)
-        throw std::runtime_error(card.file +
-                                 ": the vessel did not reach the installation pressure " +
-                                 std::to_string(p) + " Pa in " + std::to_string(card.max_cycles) +
-                                 " cycles (key 'packing.max_cycles')");
+        throw std::runtime_error(
+            card.file + ": the vessel did not reach the installation pressure " +
+            std::to_string(p) + " Pa at the target porosity in " + std::to_string(card.max_cycles) +
+            " cycles (key 'packing.max_cycles')");
     }
-    rep.steps_installation = m.step() - start;
+    rep.steps_packing += frozen_at - start;
+    rep.steps_installation = m.step() - frozen_at;
   }
+  rep.porosity_target = card.porosity;
+  rep.porosity = rep.porosity_installed = porosity_now();
   for (Wall& w : m.walls) {
     w.velocity.setZero();
     w.radial_velocity = 0;
@@ -430,7 +542,6 @@ GenesisResult run_genesis(const MaterialCard& card,
     rep.wall_stress.emplace_back(m.walls[s.wall].name, vessel.stress(m, s));
   rep.pressure = p;
   const double V_installed = vessel.volume(m);
-  rep.porosity = 1 - grain_volume_sum(m) / V_installed;
 
   // Floaters: fewer than 3 (3D) or 2 (2D) force-carrying contacts.
   auto count_contacts = [&]() {
@@ -540,6 +651,9 @@ GenesisResult run_genesis(const MaterialCard& card,
         servo_step(std::max(target, 1e-6 * p));
         m.cycle(1);
       }
+      m.clear_events();
+      if (interrupt && interrupt->load())
+        throw std::runtime_error("interrupted");
     }
     for (Wall& w : m.walls) {
       w.velocity.setZero();
@@ -560,6 +674,8 @@ GenesisResult run_genesis(const MaterialCard& card,
     rep.steps_release = m.step() - start;
   }
   const double V_final = card.cut ? card.cut->volume(dim) : V_installed;
+  if (card.cut) // grains whose centres lie inside count whole: an unbiased volume fraction
+    rep.porosity = 1 - grain_volume_sum(m) / V_final;
   {
     const Eigen::Matrix3d s = m.average_stress(V_final);
     rep.residual_mean_stress = -s.trace() / dim;

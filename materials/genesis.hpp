@@ -5,6 +5,7 @@
 #include "core/model.hpp"
 #include "materials/material_card.hpp"
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -15,9 +16,13 @@ struct GenesisReport {
   std::int64_t grains = 0, floaters = 0;
   std::int64_t contacts = 0, fj_bonded = 0, fj_gapped = 0, fj_slit = 0, pb_bonded = 0, linear = 0,
                smoothjoint = 0;
-  double porosity_target = 0, porosity_packed = 0, porosity = 0;
-  double coordination = 0; ///< mean ball-ball contacts carrying force per grain (no floaters)
-  double pressure = 0;     ///< requested installation pressure [Pa]
+  double porosity_target = 0;
+  double porosity_packed = 0;    ///< when the friction control reached the target
+  double porosity_installed = 0; ///< of the vessel at the end of installation
+  double porosity = 0;         ///< of the specimen: installed, or of the cut shape when one is cut
+  double packing_friction = 0; ///< grain friction the packing ended with
+  double coordination = 0;     ///< mean ball-ball contacts carrying force per grain (no floaters)
+  double pressure = 0;         ///< requested installation pressure [Pa]
   std::vector<std::pair<std::string, double>> wall_stress; ///< at the end of installation [Pa]
   double residual_mean_stress = 0; ///< after release [Pa], compression positive
   std::int64_t steps_packing = 0, steps_installation = 0, steps_release = 0;
@@ -32,7 +37,9 @@ struct GenesisResult {
 
 /// Run material genesis. Throws PhysicsError on blow-up and std::runtime_error when a phase does
 /// not reach its criterion within the card's max_cycles.
+/// `interrupt` (optional) is polled between chunks of cycles; when set, genesis throws.
 GenesisResult run_genesis(const MaterialCard& card,
-                          const std::function<void(const std::string&)>& progress = {});
+                          const std::function<void(const std::string&)>& progress = {},
+                          const std::atomic<bool>* interrupt = nullptr);
 
 } // namespace rocklab

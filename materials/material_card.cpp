@@ -179,8 +179,15 @@ MaterialCard load_material_card(const std::string& path) {
   if (top.has("cut"))
     c.cut = read_shape(top.object("cut"), c.dim);
   {
-    JsonObject p = top.object("packing");
-    c.cloud_porosity = p.number("cloud_porosity", {0, 1, true, true}, 0.5);
+    JsonObject p = top.optional_object("packing");
+    c.packing_method = p.choice("method", {"contraction", "scaling"}, "contraction") == "scaling"
+                           ? MaterialCard::Packing::Scaling
+                           : MaterialCard::Packing::Contraction;
+    c.packing_friction = p.number("friction", Range::non_negative(), 0.5);
+    c.porosity_tolerance = p.number("porosity_tolerance", {0, 0.1, true, false}, 0.003);
+    c.compaction_strain = p.number("compaction_strain", {0, 0.01, true, false}, 5e-4);
+    c.cloud_porosity = p.number("cloud_porosity", {0, 1, true, true},
+                                std::min(c.porosity + 0.1, 0.5 * (1 + c.porosity)));
     if (c.cloud_porosity <= c.porosity)
       p.fail("cloud_porosity", "must exceed the target porosity " + std::to_string(c.porosity));
     c.max_overlap_ratio = p.number("max_overlap_ratio", Range::positive(), 0.25);
@@ -191,7 +198,7 @@ MaterialCard load_material_card(const std::string& path) {
     p.finish();
   }
   {
-    JsonObject i = top.object("installation");
+    JsonObject i = top.optional_object("installation");
     c.pressure = i.number("pressure", Range::positive(), 1e5, "Pa");
     c.pressure_tolerance = i.number("pressure_tolerance", {0, 1, true, true}, 0.01);
     if (i.has("gap") && i.has("gap_ratio"))
@@ -222,7 +229,7 @@ MaterialCard load_material_card(const std::string& path) {
     c.fj_ten = read_dist(f, "fj_ten", "Pa");
     c.fj_coh = read_dist(f, "fj_coh", "Pa");
     c.fj.fj_exact = f.boolean("fj_exact", false);
-    JsonObject t = f.object("types");
+    JsonObject t = f.optional_object("types");
     c.frac_bonded = t.number("bonded", Range::closed(0, 1), 1.0);
     c.frac_gapped = t.number("gapped", Range::closed(0, 1), 0.0);
     c.frac_slit = t.number("slit", Range::closed(0, 1), 0.0);

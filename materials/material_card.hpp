@@ -49,6 +49,10 @@ struct MaterialCard {
   std::optional<ShapeSpec> cut; ///< test shape cut from the block
   std::uint64_t seed = 1;
   // packing
+  enum class Packing { Contraction, Scaling } packing_method = Packing::Contraction;
+  double packing_friction = 0.5;     ///< initial grain friction of the compaction [-]
+  double porosity_tolerance = 0.003; ///< allowed |porosity - target| [-]
+  double compaction_strain = 5e-4;   ///< p / E* of the soft springs used for compaction [-]
   double cloud_porosity = 0.5;
   double max_overlap_ratio = 0.25;
   double equilibrium_ratio = 1e-3; ///< mean unbalanced-force ratio for "at rest"

@@ -1,10 +1,12 @@
-// Material genesis on small 2D cards (tests/data): what the pipeline guarantees today.
+// Material genesis on small cards (tests/data): porosity, installed stress, release,
+// microstructural types, floaters, joints, cutting, determinism, exact restore and bad input.
 #include "helpers.hpp"
 #include "io/results.hpp"
 #include "io/specimen.hpp"
 #include "materials/genesis.hpp"
 
 #include <filesystem>
+#include <numbers>
 
 namespace fs = std::filesystem;
 using namespace rocklab;
@@ -20,68 +22,192 @@ fs::path scratch(const std::string& n) {
   fs::remove(p.string() + ".report.json");
   return p;
 }
+// A card file made from a test card with one text replacement.
+std::string edited_card(const char* name, const std::string& from, const std::string& to) {
+  std::string text = test::read_file(card(name));
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
+  const fs::path p = rocklab::test::scratch_root() / (std::string("edited-") + name);
+  std::ofstream(p) << text;
+  return p.string();
+}
+double grain_volume_sum(const Model& m) {
+  double v = 0;
+  for (double r : m.balls.radius)
+    v += m.settings.dim == 2 ? std::numbers::pi * r * r : 4.0 / 3.0 * std::numbers::pi * r * r * r;
+  return v;
+}
 } // namespace
 
-TEST(Genesis, ServoStressesFractionsAndRelease) {
-  for (const char* name : {"genesis_2d_rect.json", "genesis_2d_rect_pb.json"}) {
+TEST(Genesis, PorosityStressAndReleaseForEveryShape) {
+  for (const char* name :
+       {"genesis_2d_rect.json", "genesis_2d_rect_pb.json", "genesis_2d_disk.json",
+        "genesis_3d_prism.json", "genesis_3d_disk.json"}) {
     const MaterialCard c = load_material_card(card(name));
     const GenesisResult g = run_genesis(c);
     const GenesisReport& r = g.report;
-    // Grain scaling reaches the target porosity exactly in the fixed vessel.
-    EXPECT_TRUE(near_rel(r.porosity_packed, c.porosity, 1e-9)) << name;
-    // Installed: every wall within 5 % of the pressure (the servo tolerance is 1 %), so the
-    // state is isotropic within 5 % too.
+    // The specimen's porosity is the target within the acceptance band of +-0.005.
+    EXPECT_NEAR(r.porosity, c.porosity, 0.005) << name;
+    EXPECT_NEAR(r.porosity_installed, c.porosity, 0.005) << name;
+    // Installed: every wall within 5 % of the pressure (the servo tolerance is 1 %), and the
+    // spread between walls (isotropy) within 5 %.
     double lo = 1e300, hi = 0;
     for (const auto& [wall, s] : r.wall_stress) {
       EXPECT_TRUE(near_rel(s, c.pressure, 0.05)) << name << " " << wall;
       lo = std::min(lo, s);
       hi = std::max(hi, s);
     }
+    EXPECT_GE(r.wall_stress.size(), c.dim == 2 ? 1u : 3u) << name;
     EXPECT_LE((hi - lo) / c.pressure, 0.05) << name;
     // After release the mean residual stress is below the documented tolerance.
     EXPECT_LE(std::abs(r.residual_mean_stress), c.residual_tolerance * c.pressure) << name;
     EXPECT_GT(r.grains, 150) << name;
-    EXPECT_GT(r.coordination, 3.0) << name;
+    EXPECT_GT(r.coordination, c.dim == 2 ? 2.5 : 3.5) << name;
+    EXPECT_TRUE(g.model->walls.empty()) << name;
     if (c.bonding == MaterialCard::Bonding::FlatJoint) {
       const double n = static_cast<double>(r.fj_bonded + r.fj_gapped + r.fj_slit);
-      EXPECT_NEAR(r.fj_bonded / n, 0.8, 1.0 / n + 1e-12);
-      EXPECT_NEAR(r.fj_gapped / n, 0.1, 1.0 / n + 1e-12);
-      EXPECT_NEAR(r.fj_slit / n, 0.1, 1.0 / n + 1e-12);
-      // The model agrees with the report.
+      EXPECT_GT(n, 0) << name;
+      EXPECT_NEAR(r.fj_bonded / n, c.frac_bonded, 1.0 / n + 1e-12) << name;
+      EXPECT_NEAR(r.fj_gapped / n, c.frac_gapped, 1.0 / n + 1e-12) << name;
+      EXPECT_NEAR(r.fj_slit / n, c.frac_slit, 1.0 / n + 1e-12) << name;
       std::int64_t bonded = 0;
       for (const auto& fj : g.model->batches().flatjoint)
         bonded += fj.mtype == 1;
-      EXPECT_EQ(bonded, r.fj_bonded);
+      EXPECT_EQ(bonded, r.fj_bonded) << name;
     } else {
-      EXPECT_GT(r.pb_bonded, 0);
+      EXPECT_GT(r.pb_bonded, 0) << name;
+      std::int64_t bonded = 0;
+      for (const auto& pb : g.model->batches().pbond)
+        bonded += pb.s.state == 3;
+      EXPECT_EQ(bonded, r.pb_bonded) << name;
     }
   }
 }
 
+TEST(Genesis, CylinderWithRockStiffness) {
+  // Stiff contacts (E* = 30 GPa at 100 kPa): the soft compaction springs are replaced by the
+  // card's stiffness once the porosity is locked; the porosity still lands in the band.
+  const MaterialCard c = load_material_card(card("genesis_3d_cylinder.json"));
+  const GenesisResult g = run_genesis(c);
+  const GenesisReport& r = g.report;
+  EXPECT_NEAR(r.porosity, c.porosity, 0.005);
+  for (const auto& [wall, s] : r.wall_stress)
+    EXPECT_TRUE(near_rel(s, c.pressure, 0.05)) << wall;
+  EXPECT_LE(std::abs(r.residual_mean_stress), c.residual_tolerance * c.pressure);
+  EXPECT_GT(r.grains, 400);
+  // Every bonded contact got the card's flat-joint stiffness, E*/L (Eq. 40) with L = R1 + R2.
+  const Model& m = *g.model;
+  std::size_t checked = 0;
+  for (const Contact& ct : m.contacts()) {
+    if (ct.model != ModelKind::FlatJoint)
+      continue;
+    const FlatJointContact& fj = m.batches().flatjoint[ct.slot];
+    const double L = m.balls.radius[static_cast<std::size_t>(ct.end1)] +
+                     m.balls.radius[static_cast<std::size_t>(ct.end2)];
+    EXPECT_TRUE(near_rel(fj.kn, c.fj.fj_emod / L, 1e-12));
+    ++checked;
+  }
+  EXPECT_GT(checked, 1000u);
+}
+
+TEST(Genesis, TypeFractionsOnAThreeThousandGrainSpecimen) {
+  const MaterialCard c = load_material_card(card("genesis_2d_3k.json"));
+  const GenesisResult g = run_genesis(c);
+  const GenesisReport& r = g.report;
+  EXPECT_GE(r.grains, 2900);
+  EXPECT_NEAR(r.porosity, c.porosity, 0.005);
+  const double n = static_cast<double>(r.fj_bonded + r.fj_gapped + r.fj_slit);
+  EXPECT_NEAR(r.fj_bonded / n, 0.7, 0.02);
+  EXPECT_NEAR(r.fj_gapped / n, 0.2, 0.02);
+  EXPECT_NEAR(r.fj_slit / n, 0.1, 0.02);
+  // The model holds the same types; gapped contacts have their initial gap, the others none.
+  std::int64_t count[5] = {0, 0, 0, 0, 0};
+  for (const auto& fj : g.model->batches().flatjoint) {
+    ++count[fj.mtype];
+    if (fj.mtype == 2)
+      EXPECT_GT(fj.gap0, 0.0);
+    else
+      EXPECT_EQ(fj.gap0, 0.0);
+  }
+  EXPECT_EQ(count[1], r.fj_bonded);
+  EXPECT_EQ(count[2], r.fj_gapped);
+  EXPECT_EQ(count[3], r.fj_slit);
+}
+
+TEST(Genesis, FloatersAreCountedAndCanBeEliminated) {
+  const MaterialCard keep = load_material_card(card("genesis_2d_disk.json"));
+  const MaterialCard drop = load_material_card(
+      edited_card("genesis_2d_disk.json", "\"porosity\": 0.20,",
+                  "\"porosity\": 0.20, \"packing\": {\"eliminate_floaters\": true},"));
+  const GenesisResult a = run_genesis(keep), b = run_genesis(drop);
+  EXPECT_GT(a.report.floaters, 0);
+  // Everything before the floaters are removed is the same, so the counts add up.
+  EXPECT_EQ(b.report.floaters, a.report.floaters);
+  EXPECT_EQ(b.report.grains, a.report.grains - a.report.floaters);
+}
+
+TEST(Genesis, JointPlaneBecomesSmoothJoints) {
+  const MaterialCard c = load_material_card(edited_card(
+      "genesis_2d_rect.json", "\"linear\":",
+      "\"joints\": [{\"point\": [0.001, 0.002], \"dip\": 30, \"sj_kn\": 1e12, \"sj_ks\": 5e11, "
+      "\"sj_fric\": 0.4}],\n  \"linear\":"));
+  ASSERT_EQ(c.joints.size(), 1u);
+  const GenesisResult g = run_genesis(c);
+  const Model& m = *g.model;
+  const Vec3 n = joint_normal(2, 30, 0);
+  const Vec3 p0(0.001, 0.002, 0);
+  std::int64_t straddling = 0;
+  for (const Contact& ct : m.contacts()) {
+    if (ct.kind != ContactKind::BallBall)
+      continue;
+    const double da = (m.balls.pos[static_cast<std::size_t>(ct.end1)] - p0).dot(n);
+    const double db = (m.balls.pos[static_cast<std::size_t>(ct.end2)] - p0).dot(n);
+    const bool across = (da < 0) != (db < 0);
+    straddling += across;
+    EXPECT_EQ(across, ct.model == ModelKind::SmoothJoint);
+  }
+  EXPECT_GT(straddling, 10);
+  EXPECT_EQ(g.report.smoothjoint, straddling);
+}
+
+TEST(Genesis, SpecimenCutFromALargerBlock) {
+  const MaterialCard c = load_material_card(
+      edited_card("genesis_3d_prism.json", "\"installation\":",
+                  "\"cut\": {\"shape\": \"cylinder\", \"diameter\": 0.012, \"height\": 0.012},\n  "
+                  "\"installation\":"));
+  const GenesisResult g = run_genesis(c);
+  const Model& m = *g.model;
+  for (const Vec3& x : m.balls.pos)
+    EXPECT_TRUE(c.cut->contains(x));
+  EXPECT_GT(m.balls.size(), 60u);
+  EXPECT_TRUE(near_rel(g.report.porosity, 1 - grain_volume_sum(m) / c.cut->volume(3), 1e-12));
+  EXPECT_NEAR(g.report.porosity, c.porosity, 0.05); // a small cut: grains straddle its surface
+}
+
 TEST(Genesis, SameSeedSameBytesAtAnyThreadCountAndRoundTrip) {
-  const fs::path a = scratch("a.rlspec"), b = scratch("b.rlspec"), c = scratch("c.rlspec");
-  const std::string bin = test::binary() + " genesis " + card("genesis_2d_rect.json") + " -q -o ";
-  std::string out;
-  ASSERT_EQ(test::run_command(bin + a.string() + " --threads 1", &out), 0) << out;
-  ASSERT_EQ(test::run_command(bin + b.string() + " --threads 2", &out), 0) << out;
-  EXPECT_EQ(test::read_file(a), test::read_file(b));
-  EXPECT_TRUE(fs::exists(a.string() + ".report.json"));
-  // Another seed gives another packing.
-  std::string text = test::read_file(card("genesis_2d_rect.json"));
-  text.replace(text.find("\"seed\": 3"), 9, "\"seed\": 4");
-  const fs::path other = rocklab::test::scratch_root() / "rocklab-gen-seed4.json";
-  std::ofstream(other) << text;
-  ASSERT_EQ(test::run_command(
-                test::binary() + " genesis " + other.string() + " -q -o " + c.string(), &out),
-            0)
-      << out;
-  EXPECT_NE(test::read_file(a), test::read_file(c));
-  // The specimen continues exactly like the model that made it.
-  GenesisResult g = run_genesis(load_material_card(card("genesis_2d_rect.json")));
-  std::unique_ptr<Model> loaded = load_model(a.string());
-  g.model->cycle(1000);
-  loaded->cycle(1000);
-  EXPECT_EQ(results_json(*g.model, {}, "x").dump(), results_json(*loaded, {}, "x").dump());
+  for (const char* name : {"genesis_2d_rect.json", "genesis_3d_prism.json"}) {
+    const fs::path a = scratch("a.rlspec"), b = scratch("b.rlspec"), c = scratch("c.rlspec");
+    const std::string bin = test::binary() + " genesis " + card(name) + " -q -o ";
+    std::string out;
+    ASSERT_EQ(test::run_command(bin + a.string() + " --threads 1", &out), 0) << out;
+    ASSERT_EQ(test::run_command(bin + b.string() + " --threads 2", &out), 0) << out;
+    EXPECT_EQ(test::read_file(a), test::read_file(b)) << name;
+    EXPECT_TRUE(fs::exists(a.string() + ".report.json"));
+    // Another seed gives another packing.
+    const std::string other = edited_card(name, "\"seed\": ", "\"seed\": 1");
+    ASSERT_EQ(
+        test::run_command(test::binary() + " genesis " + other + " -q -o " + c.string(), &out), 0)
+        << out;
+    EXPECT_NE(test::read_file(a), test::read_file(c)) << name;
+    // The specimen continues exactly like the model that made it.
+    GenesisResult g = run_genesis(load_material_card(card(name)));
+    std::unique_ptr<Model> loaded = load_model(a.string());
+    g.model->cycle(1000);
+    loaded->cycle(1000);
+    EXPECT_EQ(results_json(*g.model, {}, "x").dump(), results_json(*loaded, {}, "x").dump())
+        << name;
+  }
 }
 
 TEST(Genesis, BadCardsFailClearlyAndWriteNothing) {
@@ -94,9 +220,13 @@ TEST(Genesis, BadCardsFailClearlyAndWriteNothing) {
   for (const Case& k :
        {Case{"\"density\": 2650", "\"density\": 2650, \"colour\": 1", "unknown key 'colour'"},
         Case{"[0.001, 0.0015]", "[0.002, 0.0015]", "R_min = 0.002 exceeds R_max = 0.0015"},
-        Case{"\"porosity\": 0.18", "\"porosity\": 1.2",
+        Case{"\"porosity\": 0.19", "\"porosity\": 1.2",
              "key 'porosity': value 1.2 is out of range (0, 1)"},
-        Case{"\"slit\": 0.1", "\"slit\": 0.2", "must sum to 1"}}) {
+        Case{"\"porosity\": 0.19", "\"porosity\": 0", "key 'porosity': value 0 is out of range"},
+        Case{"\"slit\": 0.1", "\"slit\": 0.2", "must sum to 1"},
+        Case{"\"shape\": \"rectangle\"", "\"shape\": \"hexagon\"", "key 'specimen.shape'"},
+        // Denser than any packing of these grains can be: found out by trying, then refused.
+        Case{"\"porosity\": 0.19", "\"porosity\": 0.12", "is below the porosity"}}) {
     std::string text = base;
     text.replace(text.find(k.from), std::string(k.from).size(), k.to);
     const fs::path cardfile = rocklab::test::scratch_root() / "rocklab-bad-card.json";
@@ -105,10 +235,12 @@ TEST(Genesis, BadCardsFailClearlyAndWriteNothing) {
     std::string msg;
     EXPECT_EQ(test::run_command(
                   test::binary() + " genesis " + cardfile.string() + " -o " + out.string(), &msg),
-              2);
+              2)
+        << msg;
     EXPECT_NE(msg.find(k.message), std::string::npos) << msg;
     EXPECT_NE(msg.find(cardfile.string()), std::string::npos) << msg;
     EXPECT_FALSE(fs::exists(out));
     EXPECT_FALSE(fs::exists(out.string() + ".report.json"));
+    EXPECT_FALSE(fs::exists(out.string() + ".partial"));
   }
 }

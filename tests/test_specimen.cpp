@@ -106,7 +106,7 @@ TEST(Specimen, BadFilesFailCleanly) {
     EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
   }
   // A newer version.
-  bytes.replace(bytes.find("\"version\":1"), 11, "\"version\":9");
+  bytes.replace(bytes.find("\"version\":2"), 11, "\"version\":9");
   std::ofstream(file, std::ios::binary) << bytes;
   try {
     load_model(file.string());

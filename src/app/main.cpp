@@ -55,10 +55,13 @@ int run_command(const std::string& scene_file, const std::string& out_dir, bool 
 int genesis_command(const std::string& material_file, const std::string& out, bool quiet) {
   const rocklab::MaterialCard card = rocklab::load_material_card(material_file);
   const bool tty = !quiet && ::isatty(STDERR_FILENO);
-  rocklab::GenesisResult g = rocklab::run_genesis(card, [&](const std::string& phase) {
-    if (tty)
-      std::fprintf(stderr, "[rocklab genesis] %s\n", phase.c_str());
-  });
+  rocklab::GenesisResult g = rocklab::run_genesis(
+      card,
+      [&](const std::string& phase) {
+        if (tty)
+          std::fprintf(stderr, "[rocklab genesis] %s\n", phase.c_str());
+      },
+      &g_interrupt);
   if (g_interrupt.load())
     throw std::runtime_error("interrupted; no specimen was written");
   const nlohmann::json report = g.report.to_json();
@@ -88,8 +91,10 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
     std::printf("grains       %lld (floaters %lld)   contacts %lld   coordination %.3f\n",
                 static_cast<long long>(r.grains), static_cast<long long>(r.floaters),
                 static_cast<long long>(r.contacts), r.coordination);
-    std::printf("porosity     target %.4f  packed %.4f  installed %.4f\n", r.porosity_target,
-                r.porosity_packed, r.porosity);
+    std::printf("porosity     target %.4f  locked at %.4f  installed %.4f  specimen %.4f "
+                "(packing friction %.3g)\n",
+                r.porosity_target, r.porosity_packed, r.porosity_installed, r.porosity,
+                r.packing_friction);
     std::printf(
         "bonds        flat joints: %lld bonded, %lld gapped, %lld slit; parallel bonds %lld; "
         "linear %lld; smooth joints %lld\n",

@@ -65,6 +65,7 @@ struct EventSink {
   EventBuffer* buffer = nullptr;
   std::uint64_t contact = 0;
   std::int32_t seq = 0;
+  bool slip_events = true; ///< false: slip_change events are not recorded
   void raise(Event e) noexcept {
     e.contact = contact;
     e.seq = seq++;
@@ -72,6 +73,8 @@ struct EventSink {
   }
   /// slip_change: mode 0 slip began, 1 slip ended; element 1..N for flat joints.
   void slip_change(bool began, std::int32_t element = -1) noexcept {
+    if (!slip_events)
+      return;
     Event e;
     e.type = EventType::SlipChange;
     e.mode = began ? 0 : 1;

@@ -430,7 +430,7 @@ void Model::force_displacement(double dt) {
       relative_increments(out.xc, c.n, c.s, c.t, x1, balls.vel[i1], balls.spin[i1], xb2, v2, w2, dt,
                           k);
       const std::size_t first_event = events.size();
-      EventSink sink{&events, c.key, 0};
+      EventSink sink{&events, c.key, 0, settings.slip_events};
       k.n = c.n;
       k.s = c.s;
       k.t = c.t;
@@ -755,6 +755,52 @@ std::size_t Model::apply_method(ModelKind kind, const std::string& method, doubl
       break;
     }
     case ModelKind::Linear:
+      break;
+    }
+    outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);
+  }
+  return count;
+}
+
+std::size_t Model::set_property(ModelKind kind, const std::string& name, double value,
+                                ContactSelect which) {
+  auto unknown = [&] {
+    return std::invalid_argument("contact property '" + name + "' is not a property of model '" +
+                                 std::string(model_name(kind)) + "'");
+  };
+  double LinearParams::*linear_field = nullptr;
+  if (kind == ModelKind::Linear || kind == ModelKind::PBond) {
+    if (name == "fric")
+      linear_field = &LinearParams::fric;
+    else if (name == "kn" && kind == ModelKind::Linear)
+      linear_field = &LinearParams::kn;
+    else if (name == "ks" && kind == ModelKind::Linear)
+      linear_field = &LinearParams::ks;
+    else
+      throw unknown();
+  } else if ((kind == ModelKind::FlatJoint && name != "fj_fric") ||
+             (kind == ModelKind::SmoothJoint && name != "sj_fric")) {
+    throw unknown();
+  }
+  std::size_t count = 0;
+  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+    const Contact& c = contacts_[ci];
+    if (c.model != kind || (which == ContactSelect::BallBall && c.kind != ContactKind::BallBall) ||
+        (which == ContactSelect::BallFacet && c.kind != ContactKind::BallFacet))
+      continue;
+    ++count;
+    switch (kind) {
+    case ModelKind::Linear:
+      batches_.linear[c.slot].p.*linear_field = value;
+      break;
+    case ModelKind::PBond:
+      batches_.pbond[c.slot].lp.*linear_field = value;
+      break;
+    case ModelKind::FlatJoint:
+      batches_.flatjoint[c.slot].fric = value;
+      break;
+    case ModelKind::SmoothJoint:
+      batches_.smoothjoint[c.slot].fric = value;
       break;
     }
     outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);

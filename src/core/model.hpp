@@ -30,7 +30,11 @@ struct ModelSettings {
   double timestep_safety = 0.8; ///< factor on the automatic estimate [-], (0, 1]
   double margin = 0;            ///< proximity margin [m]; 0: 0.1 x mean radius
   bool overlap_check = true;    ///< stop on an overlap beyond a radius (off for grain clouds)
+  bool slip_events = true;      ///< record slip_change events (off where nobody reads them)
 };
+
+/// Which contacts an operation applies to.
+enum class ContactSelect { All, BallBall, BallFacet };
 
 /// Which model a new contact gets. The first matching rule wins.
 struct ModelRule {
@@ -74,11 +78,19 @@ public:
   double mean_unbalanced_force_ratio() const;
   /// Append the events buffered since the last drain (in a fixed order) to out and clear them.
   void drain_events(std::vector<Event>& out);
+  /// Drop the buffered events (for callers that do not read them).
+  void clear_events() { pending_events_.clear(); }
   /// Call a contact-model method on every contact of one model: "bond" / "unbond" (contact gap
   /// in [gap_lo, gap_hi]; flat joints: `element` 1..N or 0 for all) or "sj_setforce".
   /// Returns the number of contacts called.
   std::size_t apply_method(ModelKind kind, const std::string& method, double gap_lo, double gap_hi,
                            int element = 0);
+  /// Set a property of every existing contact of one model (like PFC's `contact property`):
+  /// linear "fric", "kn" [N/m], "ks" [N/m]; linearpbond "fric" (its linear component);
+  /// flatjoint "fj_fric"; smoothjoint "sj_fric". Returns the number of contacts changed; an
+  /// unknown name throws std::invalid_argument. New contacts still follow the rules.
+  std::size_t set_property(ModelKind kind, const std::string& name, double value,
+                           ContactSelect which = ContactSelect::All);
   /// Change the proximity margin and re-detect (e.g. to reach an installation gap) [m].
   void set_margin(double margin);
   /// Remove the walls flagged in `remove` and their contacts.

@@ -6,6 +6,13 @@
 namespace rocklab {
 
 void Wall::update_bounds() {
+  if (is_cylinder()) {
+    // Conservative box: the radius plus the axial reach in every direction.
+    const double reach = cylinder_radius + (half_height > 0 ? half_height : 1e300);
+    lo = center - Vec3::Constant(reach);
+    hi = center + Vec3::Constant(reach);
+    return;
+  }
   lo = Vec3::Constant(1e300);
   hi = Vec3::Constant(-1e300);
   for (const Facet& f : facets)
@@ -19,6 +26,14 @@ void Wall::move(double dt) {
   const Vec3 dx = velocity * dt;
   const Vec3 phi = spin * dt;
   const bool rotates = phi.squaredNorm() > 0;
+  if (is_cylinder()) {
+    cylinder_radius = std::max(cylinder_radius + radial_velocity * dt, 1e-300);
+    if (rotates)
+      axis = rotate_by(axis, phi).normalized();
+    center += dx;
+    update_bounds();
+    return;
+  }
   for (Facet& f : facets)
     for (int k = 0; k < f.nv; ++k) {
       if (radial_velocity != 0)
@@ -32,6 +47,9 @@ void Wall::move(double dt) {
 double Wall::max_vertex_speed() const {
   double vmax = 0;
   const double w = spin.norm();
+  if (is_cylinder())
+    return velocity.norm() + std::abs(radial_velocity) +
+           w * (cylinder_radius + std::max(half_height, 0.0));
   for (const Facet& f : facets)
     for (int k = 0; k < f.nv; ++k)
       vmax = std::max(vmax,
@@ -78,6 +96,19 @@ Vec3 closest_on_triangle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
 } // namespace
 
 Vec3 Wall::closest_point(const Vec3& p, std::int32_t* facet) const {
+  if (is_cylinder()) {
+    if (facet)
+      *facet = 0;
+    const Vec3 r = p - center;
+    double a = r.dot(axis);
+    Vec3 radial = r - a * axis;
+    const double len = radial.norm();
+    // On the axis every direction is equally near; pick one that does not depend on p.
+    radial = len > 0 ? Vec3(radial / len) : Vec3(axis.unitOrthogonal());
+    if (half_height > 0)
+      a = std::clamp(a, -half_height, half_height);
+    return center + a * axis + cylinder_radius * radial;
+  }
   double dmin = std::numeric_limits<double>::max();
   Vec3 best = p;
   for (std::size_t f = 0; f < facets.size(); ++f) {

@@ -16,9 +16,14 @@ struct Facet {
 };
 
 /// A wall moves rigidly with a prescribed velocity and spin about its centre of rotation.
+/// It is either a set of facets or, when `cylinder_radius` > 0, an exact circular cylinder (3D)
+/// or circle (2D) of that radius about `axis` through `center`, reaching `half_height` along the
+/// axis on either side (3D; <= 0: unbounded). Balls touch a cylinder from inside or outside.
 struct Wall {
   std::string name;
   std::vector<Facet> facets;
+  double cylinder_radius = 0;   ///< > 0: an analytic cylinder/circle wall [m]
+  double half_height = 0;       ///< axial half length of a cylinder wall [m], <= 0 unbounded
   Vec3 center = Vec3::Zero();   ///< centre of rotation [m]
   Vec3 velocity = Vec3::Zero(); ///< translational velocity [m/s]
   Vec3 spin = Vec3::Zero();     ///< rotational velocity about center [rad/s]
@@ -38,6 +43,7 @@ struct Wall {
   double max_vertex_speed() const;
   /// The point of the wall closest to p (the first facet wins a tie); `facet` receives its index.
   Vec3 closest_point(const Vec3& p, std::int32_t* facet = nullptr) const;
+  bool is_cylinder() const { return cylinder_radius > 0; }
   /// Outward radial unit vector at p (zero on the axis).
   Vec3 radial_dir(const Vec3& p) const {
     Vec3 r = p - center;

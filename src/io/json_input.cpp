@@ -217,6 +217,15 @@ JsonObject JsonObject::object(const std::string& key) {
   return JsonObject(raw(key), file_, key_path(key));
 }
 
+JsonObject JsonObject::optional_object(const std::string& key) {
+  static const nlohmann::json empty = nlohmann::json::object();
+  if (!j_.contains(key)) {
+    used_.insert(key);
+    return JsonObject(empty, file_, key_path(key));
+  }
+  return object(key);
+}
+
 std::vector<std::pair<const nlohmann::json*, std::string>> JsonObject::array(const std::string& key,
                                                                              bool required) {
   used_.insert(key);

@@ -59,6 +59,8 @@ public:
   Vec3 vec(const std::string& key, int dim, std::optional<Vec3> def = std::nullopt,
            Range r = Range::any());
   JsonObject object(const std::string& key);
+  /// An optional sub-object: a missing key reads as {} (every key inside takes its default).
+  JsonObject optional_object(const std::string& key);
   /// Array elements, with their paths, for the caller to read.
   std::vector<std::pair<const nlohmann::json*, std::string>> array(const std::string& key,
                                                                    bool required = true);

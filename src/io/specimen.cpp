@@ -168,6 +168,7 @@ template <class A> void io(A& a, Wall& w) {
     for (auto& v : f.v)
       a(v);
   });
+  a(w.cylinder_radius), a(w.half_height);
   a(w.center), a(w.velocity), a(w.spin), a(w.radial_velocity), a(w.axis), a(w.radial_force),
       a(w.force), a(w.moment), a(w.lo), a(w.hi);
 }
@@ -199,7 +200,8 @@ template <class A, class T> void each(A& a, std::vector<T>& v) {
 
 template <class A> void Model::serialize(A& a) {
   a(settings.dim), a(settings.gravity), a(settings.local_damping), a(settings.timestep),
-      a(settings.timestep_safety), a(settings.margin), a(settings.overlap_check);
+      a(settings.timestep_safety), a(settings.margin), a(settings.overlap_check),
+      a(settings.slip_events);
   each(a, balls.pos), each(a, balls.vel), each(a, balls.spin), each(a, balls.force),
       each(a, balls.moment), each(a, balls.applied_force), each(a, balls.applied_moment),
       each(a, balls.disp), each(a, balls.radius), each(a, balls.mass), each(a, balls.inertia),
