@@ -247,6 +247,7 @@ nlohmann::json GenesisReport::to_json() const {
   return {{"units", "SI"},
           {"grains", grains},
           {"floaters", floaters},
+          {"specimen", shape_json(shape, dim)},
           {"porosity_target", porosity_target},
           {"porosity_packed", porosity_packed},
           {"porosity_installed", porosity_installed},
@@ -542,6 +543,24 @@ GenesisResult run_genesis(const MaterialCard& card,
     rep.wall_stress.emplace_back(m.walls[s.wall].name, vessel.stress(m, s));
   rep.pressure = p;
   const double V_installed = vessel.volume(m);
+  rep.shape.shape = card.vessel.shape;
+  switch (card.vessel.shape) {
+  case SpecimenShape::Rectangle:
+    rep.shape.size = Vec3(vessel.extent(m, 0), vessel.extent(m, 1), 0);
+    break;
+  case SpecimenShape::Prism:
+    rep.shape.size = Vec3(vessel.extent(m, 0), vessel.extent(m, 1), vessel.extent(m, 2));
+    break;
+  case SpecimenShape::Disk2D:
+    rep.shape.size = Vec3(2 * vessel.lateral_radius(m), 0, 0);
+    break;
+  case SpecimenShape::Cylinder:
+  case SpecimenShape::Disk3D:
+    rep.shape.size = Vec3(2 * vessel.lateral_radius(m), vessel.extent(m, 2), 0);
+    break;
+  }
+  if (card.cut)
+    rep.shape = *card.cut;
 
   // Floaters: fewer than 3 (3D) or 2 (2D) force-carrying contacts.
   auto count_contacts = [&]() {
@@ -707,6 +726,7 @@ GenesisResult run_genesis(const MaterialCard& card,
     }
   }
 
+  rep.dim = dim;
   rep.grains = static_cast<std::int64_t>(m.balls.size());
   rep.contacts = static_cast<std::int64_t>(m.contacts().size());
   for (const Contact& c : m.contacts()) {

@@ -102,6 +102,32 @@ Distribution read_dist(JsonObject& o, const std::string& key, const char* unit) 
   return d;
 }
 
+} // namespace
+
+nlohmann::json shape_json(const ShapeSpec& s, int dim) {
+  switch (s.shape) {
+  case SpecimenShape::Rectangle:
+    return {{"shape", "rectangle"}, {"width", s.size.x()}, {"height", s.size.y()}};
+  case SpecimenShape::Disk2D:
+    return {{"shape", "disk"}, {"diameter", s.size.x()}};
+  case SpecimenShape::Prism:
+    return {{"shape", "prism"}, {"size", {s.size.x(), s.size.y(), s.size.z()}}};
+  case SpecimenShape::Cylinder:
+    return {{"shape", "cylinder"}, {"diameter", s.size.x()}, {"height", s.size.y()}};
+  case SpecimenShape::Disk3D:
+    return {{"shape", "disk"}, {"diameter", s.size.x()}, {"thickness", s.size.y()}};
+  }
+  (void)dim;
+  return {};
+}
+
+ShapeSpec shape_from_json(const nlohmann::json& j, int dim, const std::string& file,
+                          const std::string& key) {
+  return read_shape(JsonObject(j, file, key), dim);
+}
+
+namespace {
+
 LinearProps read_linear(JsonObject o) {
   LinearProps p;
   if (o.has("emod")) {

@@ -76,6 +76,12 @@ struct MaterialCard {
   std::vector<JointSpec> joints;
 };
 
+/// A shape as JSON in the card's own form ({"shape": "cylinder", "diameter": .., "height": ..}).
+nlohmann::json shape_json(const ShapeSpec& s, int dim);
+/// Read a shape written by shape_json (or a card's `specimen`); errors name file and key.
+ShapeSpec shape_from_json(const nlohmann::json& j, int dim, const std::string& file,
+                          const std::string& key);
+
 /// Read and validate a material card; errors name the file, key, value and allowed range.
 MaterialCard load_material_card(const std::string& path);
 

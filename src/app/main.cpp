@@ -3,6 +3,7 @@
 #include "io/scene.hpp"
 #include "io/scene_run.hpp"
 #include "io/specimen.hpp"
+#include "lab/lab_test.hpp"
 #include "materials/genesis.hpp"
 
 #include <CLI/CLI.hpp>
@@ -114,6 +115,70 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
   return 0;
 }
 
+void print_lab_results(const rocklab::LabSummary& s, const std::string& out_dir) {
+  const nlohmann::json& r = s.results;
+  auto mpa = [&](const char* key) { return r.contains(key) ? r[key].get<double>() * 1e-6 : 0.0; };
+  std::printf("test         %s   material %s   grains %lld   steps %lld\n",
+              r["test"].get<std::string>().c_str(),
+              r["provenance"]["material"].get<std::string>().c_str(),
+              static_cast<long long>(r["provenance"]["grains"].get<std::int64_t>()),
+              static_cast<long long>(r["provenance"]["steps"].get<std::int64_t>()));
+  if (r.contains("peak_stress_Pa")) {
+    std::printf("peak stress  %.4g MPa (deviator %.4g MPa) at axial strain %.4g %%\n",
+                mpa("peak_stress_Pa"), mpa("peak_deviator_Pa"),
+                100 * r["peak_axial_strain"].get<double>());
+    std::printf("E            %.4g GPa tangent at 50 %% of peak, %.4g GPa secant   poisson %.3f\n",
+                1e-3 * mpa("youngs_modulus_Pa"), 1e-3 * mpa("youngs_modulus_secant_Pa"),
+                r["poisson_ratio"].get<double>());
+    if (r.value("confinement_Pa", 0.0) > 0)
+      std::printf("confinement  %.4g MPa (held between %.4g and %.4g MPa)\n", mpa("confinement_Pa"),
+                  1e-6 * r["confinement_measured_Pa"]["min"].get<double>(),
+                  1e-6 * r["confinement_measured_Pa"]["max"].get<double>());
+  }
+  if (r.contains("tensile_strength_Pa"))
+    std::printf("tensile strength %.4g MPa (peak force %.4g N)\n", mpa("tensile_strength_Pa"),
+                r["peak_force_N"].get<double>());
+  const auto& c = r["cracks"];
+  std::printf("cracks       %lld tension, %lld shear (%lld at peak)\n",
+              static_cast<long long>(c["tension"].get<std::int64_t>()),
+              static_cast<long long>(c["shear"].get<std::int64_t>()),
+              static_cast<long long>(c["at_peak"]["total"].get<std::int64_t>()));
+  std::printf("stopped      %s\n", r["stop_reason"].get<std::string>().c_str());
+  std::printf("wall time    %.1f s on %d thread(s)\n", s.wall_seconds, omp_get_max_threads());
+  std::printf("results      %s/results.json  %s/history.csv  %s/cracks.csv\n", out_dir.c_str(),
+              out_dir.c_str(), out_dir.c_str());
+  for (const auto& f : r["files"]) {
+    const std::string name = f.get<std::string>();
+    if (name.ends_with(".svg"))
+      std::printf("plot         %s/%s\n", out_dir.c_str(), name.c_str());
+    else if (name == "vtk/grains.pvd")
+      std::printf("ParaView     %s/vtk/grains.pvd (also bonds.pvd, cracks.pvd, walls.pvd; "
+                  "viz/rocklab_paraview.py sets up the view)\n",
+                  out_dir.c_str());
+  }
+}
+
+int test_command(const std::string& protocol_file, const std::string& out_dir, bool quiet,
+                 std::int64_t checkpoint_every, const std::string& resume) {
+  const rocklab::Protocol p = rocklab::load_protocol(protocol_file);
+  rocklab::LabOptions o;
+  o.out_dir = out_dir;
+  o.progress = !quiet && ::isatty(STDERR_FILENO);
+  o.interrupt = &g_interrupt;
+  o.checkpoint_every = checkpoint_every;
+  o.resume_path = resume;
+  const rocklab::LabSummary s = rocklab::run_lab_test(p, o);
+  if (s.interrupted) {
+    std::fprintf(stderr, "rocklab: interrupted; %s\n",
+                 checkpoint_every > 0 ? ("checkpoint written to " + out_dir + ".checkpoint").c_str()
+                                      : "nothing was written");
+    return 130;
+  }
+  if (!quiet)
+    print_lab_results(s, out_dir);
+  return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -145,6 +210,20 @@ int main(int argc, char** argv) {
   gen->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
   gen->add_flag("-q,--quiet", quiet, "No progress and no summary");
 
+  std::string protocol_file, test_out, resume;
+  std::int64_t checkpoint_every = 0;
+  CLI::App* test = app.add_subcommand(
+      "test", "Run a laboratory test (docs/protocol-format.md): UCS, triaxial, Brazilian or direct "
+              "tension; writes OUT/results.json, history.csv, cracks.csv, vtk/ and plots");
+  test->add_option("protocol", protocol_file, "Protocol file (JSON)")->required();
+  test->add_option("-o,--out", test_out, "Output directory")->required();
+  test->add_option("--checkpoint-every", checkpoint_every,
+                   "Write OUT.checkpoint every N steps (and on Ctrl-C)")
+      ->check(CLI::NonNegativeNumber);
+  test->add_option("--resume", resume, "Continue from a checkpoint of this protocol");
+  test->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
+  test->add_flag("-q,--quiet", quiet, "No progress and no summary");
+
   CLI::App* info = app.add_subcommand("info", "Print the version, threads and contact models");
 
   CLI11_PARSE(app, argc, argv);
@@ -158,6 +237,8 @@ int main(int argc, char** argv) {
       return run_command(scene_file, out_dir, quiet);
     if (*gen)
       return genesis_command(material_file, specimen_out, quiet);
+    if (*test)
+      return test_command(protocol_file, test_out, quiet, checkpoint_every, resume);
     if (*info) {
       std::printf("rocklab %s\nthreads %d\ncontact models: linear, linearpbond, flatjoint, "
                   "smoothjoint\nunits: SI\n",

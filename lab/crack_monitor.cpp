@@ -1,0 +1,94 @@
+#include "lab/crack_monitor.hpp"
+
+#include "io/results.hpp"
+
+namespace rocklab {
+
+void CrackMonitor::consume(const Model& m, const std::vector<Event>& events) {
+  for (const Event& e : events) {
+    if (e.type != EventType::BondBreak)
+      continue;
+    Crack c;
+    c.time = e.time;
+    c.step = e.step;
+    c.position = e.position;
+    c.normal = e.normal;
+    c.size = e.size;
+    c.mode = e.mode;
+    c.contact = e.contact;
+    c.element = e.element;
+    c.gap = e.gap;
+    c.strength = e.strength;
+    c.energy = e.energy;
+    const auto end1 = static_cast<std::size_t>(e.contact >> 32);
+    const bool facet = ((e.contact >> 31) & 1u) != 0;
+    const auto end2 = static_cast<std::size_t>(e.contact & 0x7fffffffu);
+    c.ball1 = m.balls.id[end1];
+    c.ball2 = facet ? -1 : m.balls.id[end2];
+    (c.mode == 1 ? tension_ : shear_) += 1;
+    cracks_.push_back(c);
+  }
+}
+
+std::string CrackMonitor::csv() const {
+  std::string s = "time_s,step,x_m,y_m,z_m,nx,ny,nz,size_m,mode,ball1,ball2,contact,element,gap_m,"
+                  "strength_Pa,energy_J\n";
+  for (const Crack& c : cracks_) {
+    s += format_double(c.time) + "," + std::to_string(c.step);
+    for (int k = 0; k < 3; ++k)
+      s += "," + format_double(c.position[k]);
+    for (int k = 0; k < 3; ++k)
+      s += "," + format_double(c.normal[k]);
+    s += "," + format_double(c.size) + "," + (c.mode == 1 ? "tension" : "shear") + "," +
+         std::to_string(c.ball1) + "," + std::to_string(c.ball2) + "," + std::to_string(c.contact) +
+         "," + std::to_string(c.element) + "," + format_double(c.gap) + "," +
+         format_double(c.strength) + "," + format_double(c.energy) + "\n";
+  }
+  return s;
+}
+
+nlohmann::json CrackMonitor::to_json() const {
+  nlohmann::json a = nlohmann::json::array();
+  for (const Crack& c : cracks_)
+    a.push_back({c.time,
+                 c.step,
+                 {c.position.x(), c.position.y(), c.position.z()},
+                 {c.normal.x(), c.normal.y(), c.normal.z()},
+                 c.size,
+                 c.mode,
+                 c.ball1,
+                 c.ball2,
+                 c.contact,
+                 c.element,
+                 c.gap,
+                 c.strength,
+                 c.energy});
+  return a;
+}
+
+void CrackMonitor::from_json(const nlohmann::json& a) {
+  cracks_.clear();
+  tension_ = shear_ = 0;
+  for (const auto& r : a) {
+    Crack c;
+    c.time = r[0].get<double>();
+    c.step = r[1].get<std::int64_t>();
+    for (int k = 0; k < 3; ++k) {
+      c.position[k] = r[2][k].get<double>();
+      c.normal[k] = r[3][k].get<double>();
+    }
+    c.size = r[4].get<double>();
+    c.mode = r[5].get<int>();
+    c.ball1 = r[6].get<std::int64_t>();
+    c.ball2 = r[7].get<std::int64_t>();
+    c.contact = r[8].get<std::uint64_t>();
+    c.element = r[9].get<int>();
+    c.gap = r[10].get<double>();
+    c.strength = r[11].get<double>();
+    c.energy = r[12].get<double>();
+    (c.mode == 1 ? tension_ : shear_) += 1;
+    cracks_.push_back(c);
+  }
+}
+
+} // namespace rocklab

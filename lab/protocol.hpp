@@ -1,0 +1,59 @@
+// Protocol files: what laboratory test to run on which specimen, how fast, when to stop and what
+// to write (docs/protocol-format.md). All quantities SI.
+#pragma once
+
+#include "materials/material_card.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+
+namespace rocklab {
+
+enum class TestType { Ucs, Triaxial, Brazilian, DirectTension };
+
+const char* test_type_name(TestType t);
+
+/// Default loading rate: the quasi-static rate of docs/results.md (strain rate, 1/s).
+inline constexpr double kDefaultStrainRate = 0.2;
+
+struct Protocol {
+  std::string file; ///< the protocol file (paths inside it are relative to its folder)
+  std::string name;
+  TestType type = TestType::Ucs;
+  // specimen: a specimen file, or a material card run through genesis first
+  std::string specimen_file;
+  std::string material_file;
+  nlohmann::json shape;              ///< replaces the card's specimen shape for genesis (or null)
+  std::optional<std::uint64_t> seed; ///< replaces the card's seed for genesis
+  // loading
+  double strain_rate = kDefaultStrainRate; ///< total rate: both platens together [1/s]
+  double platen_velocity = 0;              ///< > 0: speed of each platen (or grip) [m/s]
+  std::int64_t ramp_steps = 2000;          ///< the platen speed rises smoothly over this many steps
+  double seating_stress = 1e5;             ///< platens first close to this axial stress [Pa]
+  double confinement = 0;                  ///< triaxial confining stress [Pa]
+  double confinement_tolerance = 0.01;     ///< servo band during the confinement phase [-]
+  double grip_fraction = 0.1;              ///< direct tension: grips are grains this near an end
+  double reverse_at_strain = 0; ///< > 0: unload from this axial strain back to zero (elastic test)
+  // stop
+  double post_peak_fraction = 0.9; ///< stop when the load falls to this fraction of its peak
+  std::int64_t min_steps = 1000;   ///< ... but not before this many loading steps
+  double strain_limit = 0;         ///< > 0: also stop at this axial strain [-]
+  std::int64_t max_steps = 5'000'000;
+  // output
+  std::int64_t history_every = 100; ///< a history row every this many steps
+  double vtk_every_strain = 5e-4;   ///< a VTK snapshot every this much axial strain (0: none)
+  bool vtk = true;                  ///< write ParaView files
+  bool plots = true;                ///< write the SVG stress-strain plot and crack map
+  nlohmann::json raw;               ///< the file as read
+  std::string text_hash;            ///< hash of the file's text
+};
+
+/// Read and validate a protocol file; errors name the file, key, value and allowed range.
+Protocol load_protocol(const std::string& path);
+/// Read a protocol from JSON (suites embed them); `file` locates relative paths and errors.
+Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
+                            const std::string& key_path);
+
+} // namespace rocklab

@@ -1,0 +1,35 @@
+// Pictures a person can open without ParaView (any web browser): line plots and a crack map, as
+// SVG. Units are written on the axes.
+#pragma once
+
+#include "viz/vtk_output.hpp"
+
+#include <string>
+#include <vector>
+
+namespace rocklab {
+
+struct PlotSeries {
+  std::string label;
+  std::vector<double> x, y;
+  std::string color = "#1f77b4";
+  bool dashed = false;
+  bool right_axis = false; ///< plotted against the right-hand axis
+};
+
+struct PlotMarker {
+  double x = 0, y = 0;
+  std::string label;
+};
+
+/// A line plot with up to two y axes. Returns the SVG text.
+std::string line_plot_svg(const std::string& title, const std::string& xlabel,
+                          const std::string& ylabel, const std::string& y2label,
+                          const std::vector<PlotSeries>& series,
+                          const std::vector<PlotMarker>& markers = {});
+
+/// The cracks of a snapshot over its grains: 2D as it is; 3D seen along y (x right, z up), with
+/// each crack disk drawn as its projected ellipse. Red: tension, blue: shear.
+std::string crack_map_svg(const Snapshot& s, const std::string& title);
+
+} // namespace rocklab
