@@ -292,7 +292,7 @@ GenesisResult run_genesis(const MaterialCard& card,
   std::mt19937_64 rng(card.seed);
 
   const double V0 = card.vessel.volume(dim);
-  const std::vector<double> radii = sample_radii(card, (1 - card.porosity) * V0, rng);
+  std::vector<double> radii = sample_radii(card, (1 - card.porosity) * V0, rng);
   const double r_avg = [&] {
     double s = 0;
     for (double r : radii)
@@ -314,6 +314,7 @@ GenesisResult run_genesis(const MaterialCard& card,
   const Vec3 half =
       vessel_scale * (round ? Vec3(0.5 * L.x(), 0.5 * L.x(), dim == 3 ? 0.5 * L.y() : 0.0)
                             : Vec3(0.5 * L.x(), 0.5 * L.y(), dim == 3 ? 0.5 * L.z() : 0.0));
+  std::vector<Vec3> cloud;
   for (std::size_t i = 0; i < radii.size(); ++i) {
     const double r = radii[i] * grain_scale;
     // Uniform in the shape's bounding box, kept when the grain lies inside the shape.
@@ -324,7 +325,38 @@ GenesisResult run_genesis(const MaterialCard& card,
       if (card.vessel.contains(x / vessel_scale, r / vessel_scale) || attempt > 10000)
         break;
     }
-    m.balls.add(dim, static_cast<std::int64_t>(i + 1), x, r, card.density, grains);
+    cloud.push_back(x);
+  }
+  // Number the grains along a Morton (Z-order) curve of their cells, so that grains near each
+  // other in space are near each other in memory: the contact loop and the force sum then read
+  // mostly cached data (the random cloud order made them ~2x slower on big specimens).
+  {
+    const double cell = 2 * r_avg * grain_scale;
+    auto spread = [](std::uint64_t v) { // 21 bits -> every third bit
+      v &= 0x1fffff;
+      v = (v | v << 32) & 0x1f00000000ffffULL;
+      v = (v | v << 16) & 0x1f0000ff0000ffULL;
+      v = (v | v << 8) & 0x100f00f00f00f00fULL;
+      v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+      v = (v | v << 2) & 0x1249249249249249ULL;
+      return v;
+    };
+    std::vector<std::pair<std::uint64_t, std::size_t>> order(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      std::uint64_t key = 0;
+      for (int d = 0; d < dim; ++d)
+        key |= spread(static_cast<std::uint64_t>((cloud[i][d] + half[d]) / cell)) << d;
+      order[i] = {key, i};
+    }
+    std::stable_sort(order.begin(), order.end());
+    std::vector<double> sorted_radii(radii.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      const std::size_t i = order[k].second;
+      sorted_radii[k] = radii[i];
+      m.balls.add(dim, static_cast<std::int64_t>(k + 1), cloud[i], radii[i] * grain_scale,
+                  card.density, grains);
+    }
+    radii = std::move(sorted_radii);
   }
   // Packing contacts: linear springs with the card's stiffness at the mean size; frictionless
   // for the cloud relaxation, then the packing friction between grains. Vessel walls stay
