@@ -217,7 +217,7 @@ MaterialCard load_material_card(const std::string& path) {
     if (c.cloud_porosity <= c.porosity)
       p.fail("cloud_porosity", "must exceed the target porosity " + std::to_string(c.porosity));
     c.max_overlap_ratio = p.number("max_overlap_ratio", Range::positive(), 0.25);
-    c.equilibrium_ratio = p.number("equilibrium_ratio", Range::positive(), 1e-3);
+    c.equilibrium_ratio = p.number("equilibrium_ratio", Range::positive(), 5e-3);
     c.max_cycles =
         p.integer("max_cycles", 1000, std::numeric_limits<std::int64_t>::max(), 2'000'000);
     c.eliminate_floaters = p.boolean("eliminate_floaters", false);
@@ -226,7 +226,7 @@ MaterialCard load_material_card(const std::string& path) {
   {
     JsonObject i = top.optional_object("installation");
     c.pressure = i.number("pressure", Range::positive(), 1e5, "Pa");
-    c.pressure_tolerance = i.number("pressure_tolerance", {0, 1, true, true}, 0.01);
+    c.pressure_tolerance = i.number("pressure_tolerance", {0, 1, true, true}, 0.02);
     if (i.has("gap") && i.has("gap_ratio"))
       i.fail("gap", "give either 'gap' (m) or 'gap_ratio' (g_i / R_avg), not both");
     if (i.has("gap_ratio"))

@@ -55,11 +55,11 @@ struct MaterialCard {
   double compaction_strain = 5e-4;   ///< p / E* of the soft springs used for compaction [-]
   double cloud_porosity = 0.5;
   double max_overlap_ratio = 0.25;
-  double equilibrium_ratio = 1e-3; ///< mean unbalanced-force ratio for "at rest"
+  double equilibrium_ratio = 5e-3; ///< mean unbalanced-force ratio for "at rest"
   std::int64_t max_cycles = 2'000'000;
   // installation
   double pressure = 1e5; ///< material-genesis (installation) pressure [Pa]
-  double pressure_tolerance = 0.01;
+  double pressure_tolerance = 0.02;
   double install_gap = 0; ///< g_i [m]
   // contacts
   LinearProps linear; ///< grain-wall, non-bonded and new contacts
