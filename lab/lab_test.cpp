@@ -63,6 +63,8 @@ Wall plane_wall(int dim, const std::string& name, const Vec3& p, const Vec3& n, 
   return w;
 }
 
+constexpr double kServoIntegralSteps = 200; ///< integral time of the confining servo [steps]
+
 double smoothstep(double x) {
   x = std::clamp(x, 0.0, 1.0);
   return x * x * (3 - 2 * x);
@@ -223,7 +225,12 @@ private:
   double peak_time_ = 0;
   std::int64_t peak_step_ = -1, peak_tension_ = 0, peak_shear_ = 0;
   double conf_min_ = 0, conf_max_ = 0, conf_sum_ = 0;
-  std::int64_t conf_n_ = 0;
+  std::int64_t conf_n_ = 0, conf_win_n_ = 0;
+  double conf_win_sum_ = 0, conf_inst_min_ = 0, conf_inst_max_ = 0;
+  bool conf_seen_ = false;
+  double conf_peak_min_ = 0, conf_peak_max_ = 0; ///< the band up to the peak
+  std::vector<double> servo_integral_; ///< sum of the confinement error of each wall [Pa]
+  std::int64_t bond_break_events_ = 0; ///< bond_break events seen (each becomes a crack)
   double next_snapshot_strain_ = 0;
   bool snapshot_due_ = false, peak_snap_due_ = false;
   std::int64_t peak_snap_step_ = -1;
@@ -289,7 +296,9 @@ void Machine::setup() {
   }
   reference_ = m_.balls.pos;
 
-  // Contacts with the machine's walls: the specimen's ball-facet linear model, frictionless.
+  // Contacts with the machine's walls: the specimen's ball-facet linear model, frictionless
+  // (lubricated platens) except in the Brazilian test, whose platens keep the specimen's wall
+  // friction: between frictionless flat platens a disk is unstable and slides out sideways.
   LinearProps wall_props;
   bool found = false;
   for (const ModelRule& r : m_.rules)
@@ -301,7 +310,8 @@ void Machine::setup() {
   if (!found)
     throw InputError(p_.file + ": the specimen has no linear ball-facet contact rule for the "
                                "platens (specimens made by rocklab genesis have one)");
-  wall_props.fric = 0;
+  if (p_.type != TestType::Brazilian)
+    wall_props.fric = 0;
   auto add_wall = [&](Wall w) {
     m_.walls.push_back(std::move(w));
     ModelRule r;
@@ -576,17 +586,32 @@ void Machine::begin_loading() {
   LabSample s;
   measure(s);
   load_ref_ = s.load;
-  conf_min_ = conf_max_ = s.lateral_stress;
+  conf_min_ = conf_max_ = conf_inst_min_ = conf_inst_max_ = s.lateral_stress;
+  conf_peak_min_ = conf_peak_max_ = s.lateral_stress;
+  conf_seen_ = false;
+  conf_win_sum_ = 0;
+  conf_win_n_ = 0;
   next_snapshot_strain_ = p_.vtk_every_strain;
   snapshot_due_ = p_.vtk; // the start of loading
 }
 
 void Machine::control() {
   const Vec3 e = unit(axis_);
-  // Confining walls hold the confinement (in every phase).
+  // Confining walls hold the confinement (in every phase). Proportional-integral control: the
+  // proportional part alone lags behind a specimen that dilates steadily (the lag is the
+  // dilation rate over the gain, several % after the peak); the integral of the error, with a
+  // 200-step time constant, removes that lag.
+  if (servo_integral_.size() != lateral_.size())
+    servo_integral_.assign(lateral_.size(), 0.0);
   for (std::size_t k = 0; k < lateral_.size(); ++k) {
-    const double v = servo_velocity(static_cast<std::size_t>(lateral_[k]), p_.confinement,
-                                    face_area(k), lateral_stress_of(k));
+    const double stress = lateral_stress_of(k);
+    // Anti-windup: the integral never shifts the target by more than 5 %.
+    const double cap = 0.05 * p_.confinement * kServoIntegralSteps;
+    servo_integral_[k] = std::clamp(servo_integral_[k] + p_.confinement - stress, -cap, cap);
+    const double v =
+        servo_velocity(static_cast<std::size_t>(lateral_[k]),
+                       p_.confinement + servo_integral_[k] / kServoIntegralSteps, face_area(k),
+                       stress);
     Wall& w = m_.walls[static_cast<std::size_t>(lateral_[k])];
     if (lateral_axis_[k] < 0)
       w.radial_velocity = -v;
@@ -667,6 +692,8 @@ void Machine::advance() {
   m_.cycle(1);
   events_.clear();
   m_.drain_events(events_);
+  for (const Event& ev : events_)
+    bond_break_events_ += ev.type == EventType::BondBreak ? 1 : 0;
   monitor_.consume(m_, events_);
   measure(current_);
   const std::int64_t since = m_.step() - phase_start_step_;
@@ -695,10 +722,22 @@ void Machine::advance() {
   if (loading % fine == 0)
     samples_.push_back(current_);
   if (!lateral_.empty()) {
-    conf_min_ = std::min(conf_min_, current_.lateral_stress);
-    conf_max_ = std::max(conf_max_, current_.lateral_stress);
+    // The confinement band is read like a pressure gauge: 100-step means (a few stress-wave
+    // transits of a grain), so single-step spikes from breaking bonds do not count; the
+    // instantaneous extremes are reported beside it.
     conf_sum_ += current_.lateral_stress;
     ++conf_n_;
+    conf_win_sum_ += current_.lateral_stress;
+    if (++conf_win_n_ == 100) {
+      const double mean = conf_win_sum_ / 100.0;
+      conf_min_ = conf_seen_ ? std::min(conf_min_, mean) : mean;
+      conf_max_ = conf_seen_ ? std::max(conf_max_, mean) : mean;
+      conf_seen_ = true;
+      conf_win_sum_ = 0;
+      conf_win_n_ = 0;
+    }
+    conf_inst_min_ = std::min(conf_inst_min_, current_.lateral_stress);
+    conf_inst_max_ = std::max(conf_inst_max_, current_.lateral_stress);
   }
   if (phase_ == kLoad && current_.load > peak_) {
     peak_ = current_.load;
@@ -710,6 +749,8 @@ void Machine::advance() {
     peak_step_ = current_.step;
     peak_tension_ = monitor_.tension();
     peak_shear_ = monitor_.shear();
+    conf_peak_min_ = conf_min_;
+    conf_peak_max_ = conf_max_;
     if (p_.vtk && m_.step() - peak_snap_step_ >= p_.history_every) {
       peak_snap_due_ = true; // the caller copies a snapshot (throttled)
       peak_snap_step_ = m_.step();
@@ -778,7 +819,11 @@ nlohmann::json Machine::state() const {
   s["reference"] = vec_json(reference_);
   s["peak"] = {peak_,      peak_strain_, peak_stress_,  peak_force_, peak_lateral_,
                peak_time_, peak_step_,   peak_tension_, peak_shear_};
-  s["confinement_stats"] = {conf_min_, conf_max_, conf_sum_, conf_n_};
+  s["confinement_stats"] = {conf_min_,     conf_max_,      conf_sum_,     conf_n_,
+                            conf_win_sum_, conf_win_n_,    conf_inst_min_, conf_inst_max_,
+                            conf_seen_,    conf_peak_min_, conf_peak_max_};
+  s["bond_break_events"] = bond_break_events_;
+  s["servo_integral"] = servo_integral_;
   s["next_snapshot_strain"] = next_snapshot_strain_;
   s["snapshot_due"] = snapshot_due_;
   s["peak_snap_step"] = peak_snap_step_;
@@ -840,6 +885,15 @@ void Machine::restore(const nlohmann::json& s) {
   conf_max_ = cs[1];
   conf_sum_ = cs[2];
   conf_n_ = cs[3];
+  conf_win_sum_ = cs[4];
+  conf_win_n_ = cs[5];
+  conf_inst_min_ = cs[6];
+  conf_inst_max_ = cs[7];
+  conf_seen_ = cs[8];
+  conf_peak_min_ = cs[9];
+  conf_peak_max_ = cs[10];
+  bond_break_events_ = s["bond_break_events"];
+  servo_integral_ = s["servo_integral"].get<std::vector<double>>();
   next_snapshot_strain_ = s["next_snapshot_strain"];
   snapshot_due_ = s["snapshot_due"];
   peak_snap_step_ = s["peak_snap_step"];
@@ -875,6 +929,7 @@ nlohmann::json Machine::results() const {
                    {"total", peak_tension_ + peak_shear_}}},
                  {"density_per_m3", static_cast<double>(monitor_.total()) / volume_},
                  {"area_per_volume_per_m", crack_area / volume_}};
+  r["bond_break_events"] = bond_break_events_;
   r["peak_step"] = peak_step_;
   r["peak_time_s"] = peak_time_;
   r["loading_rate"] = {{"platen_velocity_m_per_s", v_final_},
@@ -909,7 +964,12 @@ nlohmann::json Machine::results() const {
       r["confinement_measured_Pa"] = {
           {"mean", conf_n_ ? conf_sum_ / static_cast<double>(conf_n_) : 0.0},
           {"min", conf_min_},
-          {"max", conf_max_}};
+          {"max", conf_max_},
+          {"averaging_steps", 100},
+          {"before_peak_min", conf_peak_min_},
+          {"before_peak_max", conf_peak_max_},
+          {"instantaneous_min", conf_inst_min_},
+          {"instantaneous_max", conf_inst_max_}};
     if (p_.reverse_at_strain > 0) {
       // Loading and unloading slopes over the same strain range (20-100 % of the reversal).
       std::vector<LabSample> up, down;
@@ -960,6 +1020,7 @@ LabSummary run_lab_test(const Protocol& p, const LabOptions& o) {
   nlohmann::json meta;
   nlohmann::json state;
   std::vector<double> vtk_times;
+  std::map<std::string, double> vtk_tagged;
   const fs::path vtk_dir = out.staged("vtk");
   if (!o.resume_path.empty()) {
     nlohmann::json cmeta;
@@ -974,6 +1035,7 @@ LabSummary run_lab_test(const Protocol& p, const LabOptions& o) {
     meta = cmeta["lab"]["specimen_meta"];
     state = cmeta["lab"]["machine"];
     vtk_times = cmeta["lab"]["vtk_times"].get<std::vector<double>>();
+    vtk_tagged = cmeta["lab"]["vtk_tagged"].get<std::map<std::string, double>>();
     sum.files = cmeta["lab"]["files"].get<std::vector<std::string>>();
     // Files written before the checkpoint (specimen, snapshots) were saved beside it.
     const fs::path saved = o.resume_path + ".files";
@@ -997,13 +1059,14 @@ LabSummary run_lab_test(const Protocol& p, const LabOptions& o) {
   } else {
     machine.restore(state);
     vtk.set_times(vtk_times);
+    vtk.set_tagged(vtk_tagged);
   }
   Snapshot peak_snap;
   bool have_peak_snap = false;
   auto write_checkpoint = [&] {
     // A peak snapshot still in memory goes into the series now, so a resumed run has it too.
     if (have_peak_snap) {
-      vtk.write(peak_snap);
+      vtk.write(peak_snap, "peak");
       have_peak_snap = false;
     }
     nlohmann::json cmeta = {{"lab",
@@ -1012,6 +1075,7 @@ LabSummary run_lab_test(const Protocol& p, const LabOptions& o) {
                               {"specimen_meta", meta},
                               {"machine", machine.state()},
                               {"vtk_times", vtk.times()},
+                              {"vtk_tagged", vtk.tagged()},
                               {"files", sum.files}}}};
     // The files written so far are kept beside the checkpoint (a copy of the staging folder).
     const fs::path files = checkpoint + ".files";
@@ -1057,12 +1121,12 @@ LabSummary run_lab_test(const Protocol& p, const LabOptions& o) {
                    static_cast<long long>(machine.cracks().total()));
     }
   }
-  // Final snapshot, then the peak one (written last, it keeps its own time in the .pvd order).
+  // The final snapshot, and the latest peak snapshot (as the "peak" files, placed in the .pvd by
+  // its time; a checkpoint may have written an earlier one already).
   if (p.vtk) {
-    Snapshot end = machine.snapshot();
-    if (have_peak_snap && peak_snap.step < end.step)
-      vtk.write(peak_snap);
-    vtk.write(end);
+    if (have_peak_snap)
+      vtk.write(peak_snap, "peak");
+    vtk.write(machine.snapshot());
     for (const std::string& f : vtk.write_collections())
       sum.files.push_back("vtk/" + f);
   }

@@ -16,7 +16,7 @@ enum class TestType { Ucs, Triaxial, Brazilian, DirectTension };
 const char* test_type_name(TestType t);
 
 /// Default loading rate: the quasi-static rate of docs/results.md (strain rate, 1/s).
-inline constexpr double kDefaultStrainRate = 0.2;
+inline constexpr double kDefaultStrainRate = 1.0;
 
 struct Protocol {
   std::string file; ///< the protocol file (paths inside it are relative to its folder)

@@ -1,5 +1,7 @@
 #include "viz/vtk_output.hpp"
 
+#include <algorithm>
+
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDoubleArray.h>
@@ -127,10 +129,12 @@ Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, doubl
   return s;
 }
 
-std::vector<std::string> VtkSeries::write(const Snapshot& s) {
+std::vector<std::string> VtkSeries::write(const Snapshot& s, const std::string& tag) {
   std::filesystem::create_directories(dir_);
-  char index[16];
+  char index[32];
   std::snprintf(index, sizeof index, "%04d", count());
+  if (!tag.empty())
+    std::snprintf(index, sizeof index, "%s", tag.c_str());
   const std::string gname = std::string("grains_") + index + ".vtu";
   const std::string bname = std::string("bonds_") + index + ".vtp";
   const std::string cname = std::string("cracks_") + index + ".vtp";
@@ -278,7 +282,10 @@ std::vector<std::string> VtkSeries::write(const Snapshot& s) {
     pd->GetCellData()->AddArray(scalar_array<std::int32_t, vtkIntArray>("wall", wall_index));
     write_poly(pd, dir_ / wname);
   }
-  times_.push_back(s.time);
+  if (tag.empty())
+    times_.push_back(s.time);
+  else
+    tagged_[tag] = s.time;
   return {gname, bname, cname, wname};
 }
 
@@ -288,12 +295,23 @@ std::vector<std::string> VtkSeries::write_collections() const {
     const char* ext = std::string(series) == "grains" ? "vtu" : "vtp";
     std::string text = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
                        "byte_order=\"LittleEndian\">\n  <Collection>\n";
+    // Numbered and tagged snapshots in time order (a tag goes before a numbered file of the
+    // same time).
+    std::vector<std::pair<double, std::string>> entries;
     for (std::size_t i = 0; i < times_.size(); ++i) {
+      char index[16];
+      std::snprintf(index, sizeof index, "%04zu", i);
+      entries.emplace_back(times_[i], index);
+    }
+    for (const auto& [tag, t] : tagged_)
+      entries.emplace_back(t, tag);
+    std::stable_sort(entries.begin(), entries.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [t, index] : entries) {
       char line[256];
-      std::snprintf(
-          line, sizeof line,
-          "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"%s_%04zu.%s\"/>\n",
-          times_[i], series, i, ext);
+      std::snprintf(line, sizeof line,
+                    "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"%s_%s.%s\"/>\n",
+                    t, series, index.c_str(), ext);
       text += line;
     }
     text += "  </Collection>\n</VTKFile>\n";

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -54,18 +55,24 @@ Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, doubl
 class VtkSeries {
 public:
   explicit VtkSeries(std::filesystem::path dir) : dir_(std::move(dir)) {}
-  /// Write one snapshot; returns the names of the files written (relative to dir).
-  std::vector<std::string> write(const Snapshot& s);
+  /// Write one snapshot; returns the names of the files written (relative to dir). With a tag
+  /// (e.g. "peak") the files are grains_TAG.vtu etc., overwritten by a later snapshot of the same
+  /// tag, and appear in the collections at their time.
+  std::vector<std::string> write(const Snapshot& s, const std::string& tag = "");
   /// Write the four .pvd collections (time = model time); returns their names.
   std::vector<std::string> write_collections() const;
   int count() const { return static_cast<int>(times_.size()); }
   /// The (time, index) list, for checkpoints.
   const std::vector<double>& times() const { return times_; }
   void set_times(std::vector<double> t) { times_ = std::move(t); }
+  /// Tagged snapshots and their times, for checkpoints.
+  const std::map<std::string, double>& tagged() const { return tagged_; }
+  void set_tagged(std::map<std::string, double> t) { tagged_ = std::move(t); }
 
 private:
   std::filesystem::path dir_;
   std::vector<double> times_;
+  std::map<std::string, double> tagged_;
 };
 
 /// Number of points, cells and the names of the point/cell arrays of a VTK XML file, read back

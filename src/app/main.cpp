@@ -4,6 +4,7 @@
 #include "io/scene_run.hpp"
 #include "io/specimen.hpp"
 #include "lab/lab_test.hpp"
+#include "lab/suite.hpp"
 #include "materials/genesis.hpp"
 
 #include <CLI/CLI.hpp>
@@ -11,6 +12,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <filesystem>
 #include <cstdio>
 #include <iostream>
 #include <unistd.h>
@@ -53,8 +55,20 @@ int run_command(const std::string& scene_file, const std::string& out_dir, bool 
   return 0;
 }
 
-int genesis_command(const std::string& material_file, const std::string& out, bool quiet) {
-  const rocklab::MaterialCard card = rocklab::load_material_card(material_file);
+int genesis_command(const std::string& material_file, const std::string& out, bool quiet,
+                    const std::string& shape, std::int64_t seed) {
+  rocklab::MaterialCard card = rocklab::load_material_card(material_file);
+  if (!shape.empty()) {
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(shape);
+    } catch (const std::exception& e) {
+      throw rocklab::InputError("--shape: not JSON: " + std::string(e.what()));
+    }
+    card.vessel = rocklab::shape_from_json(j, card.dim, "--shape", "shape");
+  }
+  if (seed >= 0)
+    card.seed = static_cast<std::uint64_t>(seed);
   const bool tty = !quiet && ::isatty(STDERR_FILENO);
   rocklab::GenesisResult g = rocklab::run_genesis(
       card,
@@ -179,6 +193,27 @@ int test_command(const std::string& protocol_file, const std::string& out_dir, b
   return 0;
 }
 
+int suite_command(const std::string& suite_file, const std::string& out_dir, bool quiet,
+                  int threads) {
+  const rocklab::Suite s = rocklab::load_suite(suite_file);
+  rocklab::SuiteOptions o;
+  o.out_dir = out_dir;
+  o.executable = std::filesystem::read_symlink("/proc/self/exe").string();
+  o.threads = threads;
+  o.progress = !quiet;
+  o.interrupt = &g_interrupt;
+  const nlohmann::json sm = rocklab::run_suite(s, o);
+  if (!quiet) {
+    std::printf("%s", rocklab::summary_table(sm).c_str());
+    std::printf("wall time    %.1f s (%d processes x %d threads)\n",
+                sm["wall_time_s"].get<double>(), sm["parallel_processes"].get<int>(),
+                sm["threads_per_process"].get<int>());
+    std::printf("summary      %s/summary.json  %s/summary.csv  %s/tests.csv\n", out_dir.c_str(),
+                out_dir.c_str(), out_dir.c_str());
+  }
+  return sm.value("failed", false) ? 1 : 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -209,6 +244,13 @@ int main(int argc, char** argv) {
   gen->add_option("-o,--out", specimen_out, "Specimen file to write")->required();
   gen->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
   gen->add_flag("-q,--quiet", quiet, "No progress and no summary");
+  std::string gen_shape;
+  std::int64_t gen_seed = -1;
+  gen->add_option("--shape", gen_shape,
+                  "Replace the card's specimen shape (JSON, e.g. '{\"shape\": \"disk\", "
+                  "\"diameter\": 0.05, \"thickness\": 0.025}')");
+  gen->add_option("--seed", gen_seed, "Replace the card's random seed")
+      ->check(CLI::NonNegativeNumber);
 
   std::string protocol_file, test_out, resume;
   std::int64_t checkpoint_every = 0;
@@ -224,10 +266,21 @@ int main(int argc, char** argv) {
   test->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
   test->add_flag("-q,--quiet", quiet, "No progress and no summary");
 
+  std::string suite_file, suite_out;
+  CLI::App* suite = app.add_subcommand(
+      "suite", "Run a suite of laboratory tests on one material in parallel processes "
+               "(docs/protocol-format.md); writes OUT/summary.json, summary.csv, tests.csv and "
+               "OUT/tests/NAME/");
+  suite->add_option("suite", suite_file, "Suite file (JSON)")->required();
+  suite->add_option("-o,--out", suite_out, "Output directory")->required();
+  suite->add_option("--threads", threads, "OpenMP threads per test process")
+      ->check(CLI::NonNegativeNumber);
+  suite->add_flag("-q,--quiet", quiet, "No progress and no summary");
+
   CLI::App* info = app.add_subcommand("info", "Print the version, threads and contact models");
 
   CLI11_PARSE(app, argc, argv);
-  if (threads > 0)
+  if (threads > 0 && !*suite)
     omp_set_num_threads(threads);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -236,7 +289,9 @@ int main(int argc, char** argv) {
     if (*run)
       return run_command(scene_file, out_dir, quiet);
     if (*gen)
-      return genesis_command(material_file, specimen_out, quiet);
+      return genesis_command(material_file, specimen_out, quiet, gen_shape, gen_seed);
+    if (*suite)
+      return suite_command(suite_file, suite_out, quiet, threads);
     if (*test)
       return test_command(protocol_file, test_out, quiet, checkpoint_every, resume);
     if (*info) {

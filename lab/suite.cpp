@@ -1,0 +1,483 @@
+#include "lab/suite.hpp"
+
+#include "io/json_input.hpp"
+#include "io/output_dir.hpp"
+#include "io/results.hpp"
+#include "lab/protocol.hpp"
+#include "materials/material_card.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+
+namespace rocklab {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+bool valid_name(const std::string& s) {
+  if (s.empty() || s.size() > 64)
+    return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+  }) && s[0] != '.';
+}
+
+// Least-squares line y = a + b x; returns {a, b, r2}.
+std::array<double, 3> line_fit(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  double sx = 0, sy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sx += x[i];
+    sy += y[i];
+  }
+  const double mx = sx / n, my = sy / n;
+  double sxx = 0, sxy = 0, syy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    sxx += (x[i] - mx) * (x[i] - mx);
+    sxy += (x[i] - mx) * (y[i] - my);
+    syy += (y[i] - my) * (y[i] - my);
+  }
+  const double b = sxy / sxx;
+  const double r2 = syy > 0 ? sxy * sxy / (sxx * syy) : 1.0;
+  return {my - b * mx, b, r2};
+}
+
+} // namespace
+
+Envelope fit_envelope(const std::vector<double>& s3, const std::vector<double>& s1) {
+  Envelope e;
+  e.points = static_cast<int>(s3.size());
+  std::set<double> distinct(s3.begin(), s3.end());
+  if (distinct.size() >= 2) {
+    // Mohr-Coulomb: sigma1 = sigma_c + q sigma3, q = (1 + sin phi) / (1 - sin phi),
+    // c = sigma_c / (2 sqrt(q)).
+    const auto [a, q, r2] = line_fit(s3, s1);
+    if (q > 1 && a > 0) {
+      e.has_mc = true;
+      e.friction_angle_deg = std::asin((q - 1) / (q + 1)) * 180.0 / 3.14159265358979323846;
+      e.cohesion = a / (2 * std::sqrt(q));
+      e.r2_mc = r2;
+    }
+  }
+  if (distinct.size() >= 3) {
+    // Hoek-Brown for intact rock (s = 1): (sigma1 - sigma3)^2 = sigma_c^2 + m_i sigma_c sigma3,
+    // a straight line in sigma3 whose intercept gives sigma_c and slope m_i sigma_c.
+    std::vector<double> y;
+    for (std::size_t i = 0; i < s3.size(); ++i)
+      y.push_back((s1[i] - s3[i]) * (s1[i] - s3[i]));
+    const auto [a, b, r2] = line_fit(s3, y);
+    if (a > 0 && b > 0) {
+      e.has_hb = true;
+      e.hb_sigma_c = std::sqrt(a);
+      e.hb_mi = b / e.hb_sigma_c;
+      e.r2_hb = r2;
+    }
+  }
+  return e;
+}
+
+Suite load_suite(const std::string& path) {
+  Suite s;
+  s.file = path;
+  const nlohmann::json j = read_json_file(path);
+  s.text_hash = text_hash(read_text(path));
+  JsonObject top(j, path, "");
+  if (top.has("units") && top.string("units") != "SI")
+    top.fail("units", "only \"SI\" is supported");
+  s.name = top.string("name", fs::path(path).stem().string());
+  top.string("description", "");
+  {
+    const std::string m = top.string("material");
+    const fs::path mp(m);
+    s.material_file =
+        mp.is_absolute() ? m : (fs::path(path).parent_path() / mp).lexically_normal().string();
+    if (!fs::exists(s.material_file))
+      top.fail("material", "\"" + s.material_file + "\" does not exist");
+    s.material = read_json_file(s.material_file);
+    load_material_card(s.material_file); // validate the card now, not in a child process
+  }
+  s.parallel = static_cast<int>(top.integer("parallel", 0, 256, 0));
+  std::set<std::string> names;
+  for (const auto& [tj, tpath] : top.array("tests")) {
+    if (!tj->is_object())
+      throw InputError(path + ": key '" + tpath + "': a test must be an object");
+    SuiteTest t;
+    nlohmann::json pj = *tj;
+    JsonObject tobj(*tj, path, tpath);
+    t.name = tobj.string("name");
+    if (!valid_name(t.name))
+      tobj.fail("name", "\"" + t.name + "\" must be 1-64 letters, digits, '_', '-' or '.'");
+    if (!names.insert(t.name).second)
+      tobj.fail("name", "\"" + t.name + "\" is used by two tests");
+    if (tobj.has("specimen"))
+      tobj.fail("specimen", "a suite's tests use the suite's material; give \"shape\" (and "
+                            "\"seed\") in the test instead");
+    if (tobj.has("shape"))
+      t.shape = tobj.raw("shape");
+    pj.erase("name");
+    pj.erase("shape");
+    t.protocol = pj;
+    // Validate the protocol now (it will be given its specimen when the suite runs).
+    nlohmann::json check = pj;
+    check["specimen"] = {{"material", fs::absolute(s.material_file).string()}};
+    if (!t.shape.is_null())
+      check["specimen"]["shape"] = t.shape;
+    const Protocol p = protocol_from_json(check, path, tpath);
+    if (!t.shape.is_null())
+      shape_from_json(t.shape, s.material.value("dimension", 3), path, tpath + ".shape");
+    t.specimen_key = t.shape.dump() + "|" + (p.seed ? std::to_string(*p.seed) : "card");
+    s.tests.push_back(std::move(t));
+  }
+  if (s.tests.empty())
+    top.fail("tests", "a suite needs at least one test");
+  top.finish();
+  return s;
+}
+
+namespace {
+
+struct Job {
+  std::string label;
+  std::vector<std::string> argv;
+  std::string log;
+  pid_t pid = -1;
+  int status = -1;
+  double seconds = 0;
+  std::chrono::steady_clock::time_point start;
+};
+
+pid_t spawn(const Job& j) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, j.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  std::vector<char*> args;
+  for (const std::string& a : j.argv)
+    args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0)
+    throw std::runtime_error("cannot start " + j.argv[0] + ": " + std::strerror(rc));
+  return pid;
+}
+
+// Run the jobs, at most `parallel` at once. On interrupt the children (which got the same
+// signal from the terminal, or get SIGINT from here) are waited for.
+void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
+  std::size_t next = 0, running = 0;
+  std::map<pid_t, std::size_t> live;
+  bool stopping = false;
+  while (next < jobs.size() || running > 0) {
+    while (!stopping && running < static_cast<std::size_t>(parallel) && next < jobs.size()) {
+      jobs[next].start = std::chrono::steady_clock::now();
+      jobs[next].pid = spawn(jobs[next]);
+      live[jobs[next].pid] = next;
+      ++running;
+      ++next;
+    }
+    if (running == 0)
+      break;
+    int st = 0;
+    const pid_t pid = waitpid(-1, &st, WNOHANG);
+    if (pid > 0 && live.count(pid)) {
+      Job& j = jobs[live[pid]];
+      live.erase(pid);
+      --running;
+      j.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
+      j.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - j.start).count();
+      if (o.progress)
+        std::fprintf(stderr, "[rocklab suite] %s %s in %.1f s\n", j.label.c_str(),
+                     j.status == 0 ? "finished" : "FAILED", j.seconds);
+      continue;
+    }
+    if (!stopping && o.interrupt && o.interrupt->load()) {
+      stopping = true;
+      for (const auto& [p, k] : live)
+        kill(p, SIGINT);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (stopping)
+    throw std::runtime_error("interrupted; nothing was written");
+}
+
+std::string last_lines(const std::string& file, int n) {
+  const std::string t = read_text(file);
+  std::size_t pos = t.size();
+  for (int k = 0; k <= n && pos > 0; ++k)
+    pos = t.rfind('\n', pos - 1);
+  return pos == std::string::npos ? t : t.substr(pos + 1);
+}
+
+double num(const nlohmann::json& r, const char* key) {
+  return r.contains(key) && r[key].is_number() ? r[key].get<double>() : std::nan("");
+}
+
+nlohmann::json or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+} // namespace
+
+nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  OutputDir out(o.out_dir);
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const int parallel = s.parallel > 0 ? s.parallel
+                                      : static_cast<int>(std::min<std::size_t>(
+                                            cores, std::max<std::size_t>(1, s.tests.size())));
+  const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(cores) / parallel);
+  const std::string material = fs::absolute(s.material_file).string();
+  fs::create_directories(out.staged("specimens"));
+  fs::create_directories(out.staged("tests"));
+  fs::create_directories(out.staged("logs"));
+
+  // 1. One genesis per specimen shared by several tests.
+  std::map<std::string, int> uses;
+  for (const SuiteTest& t : s.tests)
+    ++uses[t.specimen_key];
+  std::map<std::string, std::string> specimen_of; // key -> file name under specimens/
+  std::vector<Job> gen;
+  for (const SuiteTest& t : s.tests) {
+    if (uses[t.specimen_key] < 2 || specimen_of.count(t.specimen_key))
+      continue;
+    const std::string name = "specimen" + std::to_string(specimen_of.size() + 1) + ".rlspec";
+    specimen_of[t.specimen_key] = name;
+    Job j;
+    j.label = "genesis " + name;
+    j.argv = {o.executable, "genesis", material, "-o", out.staged("specimens/" + name).string(),
+              "--threads", std::to_string(threads), "-q"};
+    if (!t.shape.is_null())
+      j.argv.insert(j.argv.end(), {"--shape", t.shape.dump()});
+    if (t.protocol.contains("seed"))
+      j.argv.insert(j.argv.end(), {"--seed", t.protocol["seed"].dump()});
+    j.log = out.staged("logs/" + name + ".log").string();
+    gen.push_back(std::move(j));
+  }
+  run_jobs(gen, parallel, o);
+  for (const Job& j : gen)
+    if (j.status != 0)
+      throw std::runtime_error(s.file + ": " + j.label + " failed:\n" + last_lines(j.log, 5));
+
+  // 2. The tests (a specimen used once is made inside its test).
+  std::vector<Job> jobs;
+  for (const SuiteTest& t : s.tests) {
+    nlohmann::json p = t.protocol;
+    if (specimen_of.count(t.specimen_key)) {
+      p["specimen"] = {{"file", "../../specimens/" + specimen_of[t.specimen_key]}};
+      p.erase("seed");
+    } else {
+      p["specimen"] = {{"material", material}};
+      if (!t.shape.is_null())
+        p["specimen"]["shape"] = t.shape;
+    }
+    if (!p.contains("name"))
+      p["name"] = t.name;
+    const fs::path dir = out.staged("tests/" + t.name);
+    fs::create_directories(dir);
+    write_text_file(dir / "protocol.json", p.dump(2) + "\n");
+    Job j;
+    j.label = "test " + t.name;
+    j.argv = {o.executable,       "test", (dir / "protocol.json").string(), "-o",
+              (dir / "out").string(), "--threads", std::to_string(threads), "-q"};
+    j.log = out.staged("logs/" + t.name + ".log").string();
+    jobs.push_back(std::move(j));
+  }
+  run_jobs(jobs, parallel, o);
+
+  // 3. Summary.
+  nlohmann::json tests = nlohmann::json::array();
+  std::vector<double> s3, s1;
+  double ucs = std::nan(""), e = std::nan(""), nu = std::nan(""), bts = std::nan(""),
+         dt = std::nan("");
+  bool failed = false;
+  std::string csv = "name,test,status,confinement_Pa,youngs_modulus_Pa,poisson_ratio,"
+                    "peak_stress_Pa,peak_deviator_Pa,tensile_strength_Pa,cracks_tension,"
+                    "cracks_shear,grains,steps,wall_time_s\n";
+  for (std::size_t k = 0; k < s.tests.size(); ++k) {
+    const SuiteTest& t = s.tests[k];
+    const Job& j = jobs[k];
+    // Move the test's output folder up: tests/NAME/{protocol.json, results.json, ...}.
+    const fs::path dir = out.staged("tests/" + t.name);
+    nlohmann::json row{{"name", t.name}, {"test", t.protocol.value("test", "")}};
+    if (j.status != 0) {
+      failed = true;
+      row["status"] = "failed";
+      row["error"] = last_lines(j.log, 3);
+      tests.push_back(row);
+      csv += t.name + "," + row["test"].get<std::string>() + ",failed,,,,,,,,,,," +
+             format_double(j.seconds) + "\n";
+      continue;
+    }
+    for (const auto& entry : fs::directory_iterator(dir / "out"))
+      fs::rename(entry.path(), dir / entry.path().filename());
+    fs::remove(dir / "out");
+    const nlohmann::json r = read_json_file((dir / "results.json").string());
+    row["status"] = "ok";
+    row["results"] = "tests/" + t.name + "/results.json";
+    const double conf = num(r, "confinement_Pa");
+    row["confinement_Pa"] = or_null(conf);
+    for (const char* key : {"youngs_modulus_Pa", "poisson_ratio", "peak_stress_Pa",
+                            "peak_deviator_Pa", "tensile_strength_Pa"})
+      row[key] = or_null(num(r, key));
+    row["cracks"] = r["cracks"];
+    row["wall_time_s"] = r["provenance"]["wall_time_s"];
+    row["grains"] = r["provenance"]["grains"];
+    row["steps"] = r["provenance"]["steps"];
+    const std::string type = r.value("test", "");
+    if (type == "ucs" || type == "triaxial") {
+      s3.push_back(type == "ucs" ? 0.0 : conf);
+      s1.push_back(num(r, "peak_stress_Pa"));
+    }
+    if (type == "ucs" && std::isnan(ucs)) {
+      ucs = num(r, "peak_stress_Pa");
+      e = num(r, "youngs_modulus_Pa");
+      nu = num(r, "poisson_ratio");
+    }
+    if (type == "brazilian" && std::isnan(bts))
+      bts = num(r, "tensile_strength_Pa");
+    if (type == "direct_tension" && std::isnan(dt))
+      dt = num(r, "tensile_strength_Pa");
+    auto f = [&](const char* key) {
+      const double v = num(r, key);
+      return std::isfinite(v) ? format_double(v) : std::string();
+    };
+    csv += t.name + "," + type + ",ok," + f("confinement_Pa") + "," + f("youngs_modulus_Pa") +
+           "," + f("poisson_ratio") + "," + f("peak_stress_Pa") + "," + f("peak_deviator_Pa") +
+           "," + f("tensile_strength_Pa") + "," + r["cracks"]["tension"].dump() + "," +
+           r["cracks"]["shear"].dump() + "," + r["provenance"]["grains"].dump() + "," +
+           r["provenance"]["steps"].dump() + "," + format_double(j.seconds) + "\n";
+  }
+  const Envelope env = fit_envelope(s3, s1);
+  nlohmann::json props{{"youngs_modulus_Pa", or_null(e)},
+                       {"poisson_ratio", or_null(nu)},
+                       {"ucs_Pa", or_null(ucs)},
+                       {"bts_Pa", or_null(bts)},
+                       {"direct_tension_Pa", or_null(dt)},
+                       {"ucs_over_bts", or_null(ucs / bts)},
+                       {"direct_tension_over_bts", or_null(dt / bts)},
+                       {"friction_angle_deg", env.has_mc ? or_null(env.friction_angle_deg)
+                                                         : nlohmann::json(nullptr)},
+                       {"cohesion_Pa", env.has_mc ? or_null(env.cohesion) : nlohmann::json(nullptr)},
+                       {"mohr_coulomb_r2", env.has_mc ? or_null(env.r2_mc) : nlohmann::json(nullptr)},
+                       {"hoek_brown_mi", env.has_hb ? or_null(env.hb_mi) : nlohmann::json(nullptr)},
+                       {"hoek_brown_sigma_c_Pa",
+                        env.has_hb ? or_null(env.hb_sigma_c) : nlohmann::json(nullptr)},
+                       {"envelope_points", env.points}};
+  nlohmann::json summary{
+      {"suite", s.name},
+      {"suite_file", s.file},
+      {"suite_hash", s.text_hash},
+      {"material", s.material.value("name", "")},
+      {"material_file", s.material_file},
+      {"units", "SI (m, kg, s, N, Pa, J); stresses compression positive"},
+      {"properties", props},
+      {"tests", tests},
+      {"parallel_processes", parallel},
+      {"threads_per_process", threads},
+      {"rocklab_version", ROCKLAB_VERSION},
+      {"wall_time_s", std::chrono::duration<double>(clock::now() - t0).count()}};
+  auto cell = [](const nlohmann::json& v) {
+    return v.is_number() ? format_double(v.get<double>()) : std::string();
+  };
+  std::string scsv = "material,youngs_modulus_Pa,poisson_ratio,ucs_Pa,bts_Pa,direct_tension_Pa,"
+                     "ucs_over_bts,friction_angle_deg,cohesion_Pa,hoek_brown_mi\n";
+  scsv += summary["material"].get<std::string>();
+  for (const char* k : {"youngs_modulus_Pa", "poisson_ratio", "ucs_Pa", "bts_Pa",
+                        "direct_tension_Pa", "ucs_over_bts", "friction_angle_deg", "cohesion_Pa",
+                        "hoek_brown_mi"})
+  {
+    scsv += ',';
+    scsv += cell(props[k]);
+  }
+  scsv += "\n";
+  write_text_file(out.staged("summary.json"), summary.dump(2) + "\n");
+  write_text_file(out.staged("summary.csv"), scsv);
+  write_text_file(out.staged("tests.csv"), csv);
+  out.commit();
+  if (failed)
+    summary["failed"] = true;
+  return summary;
+}
+
+std::string summary_table(const nlohmann::json& sm) {
+  std::string t;
+  char line[256];
+  std::snprintf(line, sizeof line, "suite %s   material %s\n", sm["suite"].get<std::string>().c_str(),
+                sm["material"].get<std::string>().c_str());
+  t += line;
+  t += "test                 type            conf [MPa]  E [GPa]   nu     peak [MPa]  tensile "
+       "[MPa]  cracks  time [s]\n";
+  auto mpa = [](const nlohmann::json& v, double scale) {
+    char b[32];
+    if (v.is_number())
+      std::snprintf(b, sizeof b, "%.4g", v.get<double>() * scale);
+    else
+      std::snprintf(b, sizeof b, "-");
+    return std::string(b);
+  };
+  for (const auto& r : sm["tests"]) {
+    if (r["status"] != "ok") {
+      std::snprintf(line, sizeof line, "%-20s %-15s FAILED (see logs/%s.log)\n",
+                    r["name"].get<std::string>().c_str(), r["test"].get<std::string>().c_str(),
+                    r["name"].get<std::string>().c_str());
+      t += line;
+      continue;
+    }
+    std::snprintf(line, sizeof line, "%-20s %-15s %-11s %-9s %-6s %-11s %-13s %-7lld %.1f\n",
+                  r["name"].get<std::string>().c_str(), r["test"].get<std::string>().c_str(),
+                  mpa(r["confinement_Pa"], 1e-6).c_str(), mpa(r["youngs_modulus_Pa"], 1e-9).c_str(),
+                  mpa(r["poisson_ratio"], 1).c_str(), mpa(r["peak_stress_Pa"], 1e-6).c_str(),
+                  mpa(r["tensile_strength_Pa"], 1e-6).c_str(),
+                  static_cast<long long>(r["cracks"]["total"].get<std::int64_t>()),
+                  r["wall_time_s"].get<double>());
+    t += line;
+  }
+  const auto& p = sm["properties"];
+  std::snprintf(line, sizeof line,
+                "E %s GPa   nu %s   UCS %s MPa   BTS %s MPa   direct tension %s MPa   UCS/BTS %s\n",
+                mpa(p["youngs_modulus_Pa"], 1e-9).c_str(), mpa(p["poisson_ratio"], 1).c_str(),
+                mpa(p["ucs_Pa"], 1e-6).c_str(), mpa(p["bts_Pa"], 1e-6).c_str(),
+                mpa(p["direct_tension_Pa"], 1e-6).c_str(), mpa(p["ucs_over_bts"], 1).c_str());
+  t += line;
+  std::snprintf(line, sizeof line,
+                "Mohr-Coulomb: friction angle %s deg, cohesion %s MPa (R2 %s)   Hoek-Brown m_i %s "
+                "(%d points)\n",
+                mpa(p["friction_angle_deg"], 1).c_str(), mpa(p["cohesion_Pa"], 1e-6).c_str(),
+                mpa(p["mohr_coulomb_r2"], 1).c_str(), mpa(p["hoek_brown_mi"], 1).c_str(),
+                p["envelope_points"].get<int>());
+  t += line;
+  return t;
+}
+
+} // namespace rocklab

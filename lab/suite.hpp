@@ -1,0 +1,59 @@
+// Lab-test suites: several protocols on one material, run as parallel processes, summarised in
+// one table (E, nu, UCS, BTS, direct tension, UCS/BTS, Mohr-Coulomb and Hoek-Brown envelopes).
+// Format in docs/protocol-format.md. All quantities SI.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <string>
+#include <vector>
+
+namespace rocklab {
+
+struct SuiteTest {
+  std::string name;          ///< also the test's folder under OUTDIR/tests
+  nlohmann::json protocol;   ///< the protocol without its specimen
+  nlohmann::json shape;      ///< specimen shape for genesis (null: the card's)
+  std::string specimen_key;  ///< tests with the same key share one specimen
+};
+
+struct Suite {
+  std::string file, name;
+  std::string material_file; ///< the material card (absolute or relative to the working dir)
+  nlohmann::json material;   ///< the card as read
+  std::vector<SuiteTest> tests;
+  int parallel = 0;          ///< processes at once (0: one per core)
+  std::string text_hash;
+};
+
+/// Read and validate a suite file; every test's protocol is validated too (errors name the
+/// file and the key, e.g. tests[2].loading.confinement).
+Suite load_suite(const std::string& path);
+
+/// Strength envelopes from (confinement, peak axial stress) pairs, SI.
+struct Envelope {
+  int points = 0;
+  double friction_angle_deg = 0, cohesion = 0, r2_mc = 0; ///< Mohr-Coulomb, >= 2 confinements
+  bool has_mc = false;
+  double hb_mi = 0, hb_sigma_c = 0, r2_hb = 0; ///< Hoek-Brown (intact, s = 1), >= 3 confinements
+  bool has_hb = false;
+};
+Envelope fit_envelope(const std::vector<double>& sigma3, const std::vector<double>& sigma1);
+
+struct SuiteOptions {
+  std::string out_dir;
+  std::string executable; ///< the rocklab binary that runs each test (this process's own)
+  int threads = 0;        ///< OpenMP threads per process (0: cores / parallel, at least 1)
+  bool progress = false;
+  const std::atomic<bool>* interrupt = nullptr;
+};
+
+/// Run the suite; writes OUTDIR/summary.json, summary.csv, tests.csv, specimens/, tests/NAME/.
+/// Returns the summary. Nothing is left in OUTDIR when it fails or is interrupted.
+nlohmann::json run_suite(const Suite& s, const SuiteOptions& o);
+
+/// The printed table of a summary.
+std::string summary_table(const nlohmann::json& summary);
+
+} // namespace rocklab

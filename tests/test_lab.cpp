@@ -1,0 +1,425 @@
+// The test machine: results, crack records, ParaView files, elastic check, triaxial servo,
+// suites, bad protocols, checkpoint/resume and SIGINT. Tiny specimens keep these fast.
+#include "helpers.hpp"
+
+#include "io/json_input.hpp"
+#include "io/specimen.hpp"
+#include "lab/lab_test.hpp"
+#include "lab/suite.hpp"
+#include "viz/vtk_output.hpp"
+
+#include <csignal>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sys/wait.h>
+#include <thread>
+
+namespace fs = std::filesystem;
+using namespace rocklab;
+
+namespace {
+
+std::string data(const std::string& name) {
+  return test::source_dir() + "/tests/data/" + name;
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path p = test::scratch_root() / name;
+  fs::remove_all(p);
+  return p;
+}
+
+// Write a protocol file in the scratch folder.
+std::string protocol(const std::string& name, const nlohmann::json& j) {
+  const fs::path p = test::scratch_root() / (name + ".json");
+  std::ofstream(p) << j.dump(2);
+  return p.string();
+}
+
+// A specimen made once per test process (genesis of a tiny card), shared by the tests.
+const std::string& specimen(const std::string& card) {
+  static std::map<std::string, std::string> made;
+  auto it = made.find(card);
+  if (it != made.end())
+    return it->second;
+  const fs::path out = test::scratch_root() / (card + ".rlspec");
+  std::string msg;
+  EXPECT_EQ(test::run_command(test::binary() + " genesis " + data(card + ".json") + " -o " +
+                                  out.string() + " -q --threads 1",
+                              &msg),
+            0)
+      << msg;
+  return made[card] = out.string();
+}
+
+LabSummary run(const std::string& name, const nlohmann::json& j, const fs::path& out) {
+  const Protocol p = load_protocol(protocol(name, j));
+  LabOptions o;
+  o.out_dir = out.string();
+  return run_lab_test(p, o);
+}
+
+std::vector<std::vector<std::string>> read_csv(const fs::path& p) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(p);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> row;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ','))
+      row.push_back(cell);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+bool has(const std::vector<std::string>& v, const std::string& s) {
+  return std::find(v.begin(), v.end(), s) != v.end();
+}
+
+} // namespace
+
+TEST(Lab, UcsWritesResultsCracksAndReadableParaViewFiles) {
+  const fs::path out = scratch("ucs");
+  const LabSummary s = run("ucs", {{"test", "ucs"}, {"specimen", {{"file", specimen("lab_2d_fj")}}}},
+                           out);
+  const nlohmann::json r = read_json_file((out / "results.json").string());
+  EXPECT_EQ(r, s.results);
+  // The results a rock engineer reads.
+  EXPECT_GT(r["peak_stress_Pa"].get<double>(), 1e6);
+  EXPECT_GT(r["youngs_modulus_Pa"].get<double>(), 1e8);
+  EXPECT_GT(r["poisson_ratio"].get<double>(), 0.0);
+  EXPECT_LT(r["poisson_ratio"].get<double>(), 0.5);
+  EXPECT_EQ(r["stop_reason"], "the load fell below 0.9 of its peak");
+  EXPECT_GT(r["provenance"]["grains"].get<int>(), 100);
+  for (const char* k : {"rocklab_version", "material_hash", "seed", "steps", "wall_time_s"})
+    EXPECT_TRUE(r["provenance"].contains(k)) << k;
+
+  // Every bond_break event became one crack record; each lies inside the specimen.
+  const auto cracks = read_csv(out / "cracks.csv");
+  ASSERT_GT(cracks.size(), 2u);
+  const std::int64_t total = r["cracks"]["total"];
+  EXPECT_GT(total, 10);
+  EXPECT_EQ(static_cast<std::int64_t>(cracks.size()) - 1, total);
+  EXPECT_EQ(r["bond_break_events"].get<std::int64_t>(), total);
+  EXPECT_EQ(r["cracks"]["tension"].get<std::int64_t>() + r["cracks"]["shear"].get<std::int64_t>(),
+            total);
+  const auto& header = cracks[0];
+  const auto col = [&](const std::string& name) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  ASSERT_LT(col("x_m"), header.size());
+  const double w = r["specimen"]["width_m"].get<double>(), h = r["specimen"]["height_m"];
+  for (std::size_t i = 1; i < cracks.size(); ++i) {
+    const double x = std::stod(cracks[i][col("x_m")]), y = std::stod(cracks[i][col("y_m")]);
+    EXPECT_LT(std::abs(x), 0.5 * w + 1e-3) << "crack " << i;
+    EXPECT_LT(std::abs(y), 0.5 * h + 1e-3) << "crack " << i;
+  }
+  // history.csv: crack counts by mode and the last row agree with the results.
+  const auto hist = read_csv(out / "history.csv");
+  for (const char* c : {"axial_strain", "lateral_strain", "axial_stress_Pa", "lateral_stress_Pa",
+                        "cracks_tension", "cracks_shear", "kinetic_J", "strain_J"})
+    EXPECT_TRUE(has(hist[0], c)) << c;
+  const auto hc = std::find(hist[0].begin(), hist[0].end(), "cracks_total") - hist[0].begin();
+  EXPECT_EQ(std::stoll(hist.back()[static_cast<std::size_t>(hc)]), total);
+
+  // ParaView: every file of every .pvd exists and reads back with VTK's XML readers.
+  int files = 0;
+  for (const char* series : {"grains", "bonds", "cracks", "walls"}) {
+    const std::string pvd = test::read_file(out / "vtk" / (std::string(series) + ".pvd"));
+    std::regex ref("file=\"([^\"]+)\"");
+    int n = 0;
+    for (auto it = std::sregex_iterator(pvd.begin(), pvd.end(), ref); it != std::sregex_iterator();
+         ++it, ++n) {
+      const fs::path f = out / "vtk" / (*it)[1].str();
+      ASSERT_TRUE(fs::exists(f)) << f;
+      const VtkFileInfo info = read_vtk_info(f.string());
+      ++files;
+      if (std::string(series) == "grains") {
+        EXPECT_EQ(info.points, r["provenance"]["grains"].get<long long>());
+        for (const char* a : {"radius", "velocity", "displacement", "group"})
+          EXPECT_TRUE(has(info.point_arrays, a)) << a;
+      } else if (std::string(series) == "bonds") {
+        EXPECT_GT(info.cells, 0);
+        EXPECT_EQ(info.points, 2 * info.cells);
+        for (const char* a : {"bond_state", "broken_fraction"})
+          EXPECT_TRUE(has(info.cell_arrays, a)) << a;
+      } else if (std::string(series) == "cracks") {
+        for (const char* a : {"mode", "time"})
+          EXPECT_TRUE(has(info.cell_arrays, a)) << a;
+      } else {
+        EXPECT_EQ(info.cells, 2); // the two platens (segments in 2D)
+      }
+    }
+    EXPECT_GE(n, 3) << series; // start, peak, end at least
+  }
+  // The final crack file holds every crack.
+  const std::string pvd = test::read_file(out / "vtk" / "cracks.pvd");
+  const auto last = pvd.rfind("file=\"");
+  const std::string name = pvd.substr(last + 6, pvd.find('"', last + 6) - last - 6);
+  EXPECT_EQ(read_vtk_info((out / "vtk" / name).string()).cells, total);
+  EXPECT_GE(files, 12);
+  // Pictures without ParaView.
+  for (const char* f : {"stress_strain.svg", "crack_map.svg"}) {
+    const std::string svg = test::read_file(out / f);
+    EXPECT_EQ(svg.rfind("<svg", 0) == 0 || svg.find("<svg") != std::string::npos, true) << f;
+    EXPECT_NE(svg.find("</svg>"), std::string::npos) << f;
+  }
+}
+
+TEST(Lab, ThreeDimensionalCylinderCracksAreDisks) {
+  const fs::path out = scratch("ucs3d");
+  const LabSummary s =
+      run("ucs3d",
+          {{"test", "ucs"}, {"specimen", {{"file", specimen("lab_3d_fj")}}}, {"stop", {{"strain_limit", 0.012}}}},
+          out);
+  const nlohmann::json& r = s.results;
+  EXPECT_GT(r["peak_stress_Pa"].get<double>(), 1e6);
+  const std::int64_t total = r["cracks"]["total"];
+  ASSERT_GT(total, 0);
+  const auto cracks = read_csv(out / "cracks.csv");
+  EXPECT_EQ(static_cast<std::int64_t>(cracks.size()) - 1, total);
+  const double radius = 0.5 * r["specimen"]["diameter_m"].get<double>();
+  const double h = r["specimen"]["height_m"];
+  const auto& header = cracks[0];
+  auto col = [&](const char* n) {
+    return static_cast<std::size_t>(std::find(header.begin(), header.end(), n) - header.begin());
+  };
+  for (std::size_t i = 1; i < cracks.size(); ++i) {
+    const double x = std::stod(cracks[i][col("x_m")]), y = std::stod(cracks[i][col("y_m")]),
+                 z = std::stod(cracks[i][col("z_m")]);
+    EXPECT_LT(std::hypot(x, y), radius + 1e-3);
+    EXPECT_LT(std::abs(z), 0.5 * h + 1e-3);
+  }
+  const std::string pvd = test::read_file(out / "vtk" / "cracks.pvd");
+  const auto last = pvd.rfind("file=\"");
+  const std::string name = pvd.substr(last + 6, pvd.find('"', last + 6) - last - 6);
+  const VtkFileInfo info = read_vtk_info((out / "vtk" / name).string());
+  EXPECT_EQ(info.cells, total);
+  EXPECT_GE(info.points, 8 * info.cells); // each crack a polygon
+}
+
+TEST(Lab, ElasticLoadingEqualsUnloadingOnAFullyBondedSpecimen) {
+  // All contacts bonded: a tiny reversed test is elastic (loading slope = unloading slope), and
+  // its modulus equals the UCS test's modulus at 1 % of its peak.
+  const std::string spec = specimen("lab_2d_bonded");
+  const LabSummary ucs =
+      run("elastic_ucs", {{"test", "ucs"}, {"specimen", {{"file", spec}}}}, scratch("el_ucs"));
+  const double strain_1pc = [&] {
+    // the strain at 1 % of the peak is far below any breakage
+    return 0.01 * ucs.results["peak_axial_strain"].get<double>();
+  }();
+  const LabSummary rev = run("elastic_rev",
+                             {{"test", "ucs"},
+                              {"specimen", {{"file", spec}}},
+                              {"loading", {{"reverse_at_strain", strain_1pc}, {"ramp_steps", 200}}},
+                              {"output", {{"vtk", false}}}},
+                             scratch("el_rev"));
+  const double e_up = rev.results["youngs_modulus_loading_Pa"];
+  const double e_down = rev.results["youngs_modulus_unloading_Pa"];
+  EXPECT_TRUE(test::near_rel(e_down, e_up, 0.03));
+  EXPECT_EQ(rev.results["cracks"]["total"], 0);
+  EXPECT_EQ(rev.results["stop_reason"], "unloaded to the start");
+  EXPECT_TRUE(test::near_rel(ucs.results["youngs_modulus_initial_Pa"].get<double>(), e_up, 0.05));
+}
+
+TEST(Lab, TriaxialHoldsTheConfinementAndPeakRisesWithIt) {
+  const std::string spec = specimen("lab_3d_fj");
+  double last_peak = 0;
+  for (double conf : {0.0, 2e5, 5e5}) {
+    nlohmann::json j{{"test", conf > 0 ? "triaxial" : "ucs"},
+                     {"specimen", {{"file", spec}}},
+                     {"output", {{"vtk", false}, {"plots", false}}}};
+    if (conf > 0)
+      j["loading"] = {{"confinement", conf}};
+    const LabSummary s = run("tri", j, scratch("tri"));
+    const nlohmann::json& r = s.results;
+    const double peak = r["peak_stress_Pa"];
+    EXPECT_GT(peak, last_peak + 0.5 * conf) << "confinement " << conf;
+    last_peak = peak;
+    if (conf > 0) {
+      const auto& c = r["confinement_measured_Pa"];
+      EXPECT_TRUE(test::near_rel(c["before_peak_min"].get<double>(), conf, 0.02)) << c.dump();
+      EXPECT_TRUE(test::near_rel(c["before_peak_max"].get<double>(), conf, 0.02)) << c.dump();
+      EXPECT_TRUE(test::near_rel(c["mean"].get<double>(), conf, 0.02)) << c.dump();
+    }
+  }
+}
+
+TEST(Lab, BrazilianAndDirectTension) {
+  const LabSummary bz = run("bz",
+                            {{"test", "brazilian"},
+                             {"specimen",
+                              {{"material", data("lab_2d_fj.json")},
+                               {"shape", {{"shape", "disk"}, {"diameter", 0.02}}}}},
+                             {"output", {{"vtk", false}}}},
+                            scratch("bz"));
+  const nlohmann::json& b = bz.results;
+  // BTS = 2F / (pi D t), t = 1 m in 2D.
+  EXPECT_TRUE(test::near_rel(b["tensile_strength_Pa"].get<double>(),
+                             2 * b["peak_force_N"].get<double>() /
+                                 (M_PI * b["specimen"]["diameter_m"].get<double>()),
+                             1e-12));
+  EXPECT_GT(b["cracks"]["tension"].get<int>(), 0);
+  EXPECT_GT(b["tensile_strength_Pa"].get<double>(), 1e5);
+  const LabSummary dt = run("dt",
+                            {{"test", "direct_tension"},
+                             {"specimen", {{"file", specimen("lab_2d_fj")}}},
+                             {"output", {{"vtk", false}}}},
+                            scratch("dt"));
+  EXPECT_GT(dt.results["tensile_strength_Pa"].get<double>(), 1e5);
+  EXPECT_GT(dt.results["cracks"]["tension"].get<int>(), 0);
+  // Tension is far weaker than compression in a flat-jointed rock.
+  EXPECT_LT(dt.results["tensile_strength_Pa"].get<double>(), 5e6);
+}
+
+TEST(Lab, EnvelopeFitRecoversMohrCoulombAndHoekBrown) {
+  const double phi = 35.0 * M_PI / 180, c = 20e6;
+  const double q = (1 + std::sin(phi)) / (1 - std::sin(phi));
+  std::vector<double> s3{0, 2e6, 5e6, 10e6}, s1;
+  for (double x : s3)
+    s1.push_back(2 * c * std::sqrt(q) + q * x);
+  Envelope e = fit_envelope(s3, s1);
+  ASSERT_TRUE(e.has_mc);
+  EXPECT_TRUE(test::near_rel(e.friction_angle_deg, 35.0, 1e-9));
+  EXPECT_TRUE(test::near_rel(e.cohesion, c, 1e-9));
+  s1.clear();
+  const double sc = 200e6, mi = 25;
+  for (double x : s3)
+    s1.push_back(x + sc * std::sqrt(mi * x / sc + 1));
+  e = fit_envelope(s3, s1);
+  ASSERT_TRUE(e.has_hb);
+  EXPECT_TRUE(test::near_rel(e.hb_mi, mi, 1e-9));
+  EXPECT_TRUE(test::near_rel(e.hb_sigma_c, sc, 1e-9));
+  EXPECT_FALSE(fit_envelope({0, 2e6}, {1e8, 1.1e8}).has_hb); // two points: no Hoek-Brown
+}
+
+TEST(Lab, SuiteRunsTestsInParallelAndSummarises) {
+  const fs::path dir = test::scratch_root() / "suite";
+  fs::create_directories(dir);
+  nlohmann::json suite{
+      {"name", "tiny"},
+      {"material", data("lab_2d_fj.json")},
+      {"parallel", 2},
+      {"tests",
+       {{{"name", "ucs"}, {"test", "ucs"}, {"output", {{"vtk", false}}}},
+        {{"name", "tri"},
+         {"test", "triaxial"},
+         {"loading", {{"confinement", 5e5}}},
+         {"output", {{"vtk", false}}}},
+        {{"name", "bz"},
+         {"test", "brazilian"},
+         {"shape", {{"shape", "disk"}, {"diameter", 0.02}}},
+         {"output", {{"vtk", false}}}}}}};
+  std::ofstream(dir / "suite.json") << suite.dump(2);
+  const fs::path out = scratch("suite_out");
+  std::string msg;
+  ASSERT_EQ(test::run_command(test::binary() + " suite " + (dir / "suite.json").string() + " -o " +
+                                  out.string() + " --threads 1",
+                              &msg),
+            0)
+      << msg;
+  EXPECT_NE(msg.find("UCS/BTS"), std::string::npos) << msg;
+  const nlohmann::json sm = read_json_file((out / "summary.json").string());
+  const auto& p = sm["properties"];
+  EXPECT_GT(p["ucs_Pa"].get<double>(), 0);
+  EXPECT_GT(p["bts_Pa"].get<double>(), 0);
+  EXPECT_TRUE(test::near_rel(p["ucs_over_bts"].get<double>(),
+                             p["ucs_Pa"].get<double>() / p["bts_Pa"].get<double>(), 1e-12));
+  EXPECT_TRUE(p["friction_angle_deg"].is_number()) << p.dump(); // two confinements: MC fit
+  EXPECT_TRUE(p["hoek_brown_mi"].is_null());                    // ... but no Hoek-Brown
+  for (const char* t : {"ucs", "tri", "bz"})
+    EXPECT_TRUE(fs::exists(out / "tests" / t / "results.json")) << t;
+  // The UCS and the triaxial test shared one specimen (genesis once).
+  EXPECT_TRUE(fs::exists(out / "specimens" / "specimen1.rlspec"));
+  EXPECT_EQ(read_csv(out / "tests.csv").size(), 4u);
+  EXPECT_EQ(read_csv(out / "summary.csv").size(), 2u);
+}
+
+TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
+  struct Case {
+    nlohmann::json j;
+    const char* message;
+  };
+  const std::string spec = specimen("lab_2d_fj");
+  const std::vector<Case> cases{
+      {{{"test", "shear_box"}, {"specimen", {{"file", spec}}}}, "key 'test'"},
+      {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"strain_rate", -1}}}},
+       "key 'loading.strain_rate'"},
+      {{{"test", "ucs"}}, "key 'specimen'"},
+      {{{"test", "ucs"}, {"specimen", {{"file", "/nonexistent.rlspec"}}}}, "does not exist"},
+      {{{"test", "triaxial"}, {"specimen", {{"file", spec}}}}, "key 'loading.confinement'"},
+      {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"colour", 1}}, "unknown key 'colour'"},
+      {{{"test", "brazilian"}, {"specimen", {{"file", spec}}}}, "needs a disk specimen"}};
+  for (const Case& k : cases) {
+    const std::string file = protocol("bad", k.j);
+    const fs::path out = scratch("bad_out");
+    std::string msg;
+    EXPECT_EQ(test::run_command(test::binary() + " test " + file + " -o " + out.string(), &msg), 2)
+        << msg;
+    EXPECT_NE(msg.find(k.message), std::string::npos) << msg;
+    EXPECT_NE(msg.find(file), std::string::npos) << msg;
+    EXPECT_FALSE(fs::exists(out)) << k.j.dump();
+  }
+}
+
+TEST(Lab, CheckpointResumeIsByteIdenticalAndSigintLeavesACheckpointOrNothing) {
+  const std::string spec = specimen("lab_2d_fj");
+  const std::string file =
+      protocol("cp", {{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"strain_rate", 0.2}}}});
+  const fs::path full = scratch("cp_full");
+  std::string msg;
+  ASSERT_EQ(test::run_command(test::binary() + " test " + file + " -o " + full.string() +
+                                  " -q --threads 1",
+                              &msg),
+            0)
+      << msg;
+  // Interrupt a checkpointing run once it has written a checkpoint, then resume it.
+  for (bool checkpointing : {true, false}) {
+    const fs::path out = scratch(checkpointing ? "cp_part" : "cp_none");
+    const std::string cp = out.string() + ".checkpoint";
+    fs::remove(cp);
+    fs::remove_all(cp + ".files");
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const std::string every = checkpointing ? "2000" : "0";
+      execl(test::binary().c_str(), "rocklab", "test", file.c_str(), "-o", out.c_str(), "-q",
+            "--threads", "1", "--checkpoint-every", every.c_str(), static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    for (int i = 0; i < 400 && !(checkpointing ? fs::exists(cp) : false); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(checkpointing ? 10 : 2));
+    if (!checkpointing)
+      std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    kill(pid, SIGINT);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status));
+    ASSERT_EQ(WEXITSTATUS(status), 130) << "the run finished before it was interrupted";
+    EXPECT_FALSE(fs::exists(out)); // an interrupted run writes no OUTDIR
+    if (!checkpointing) {
+      EXPECT_FALSE(fs::exists(cp));
+      continue;
+    }
+    ASSERT_TRUE(fs::exists(cp));
+    ASSERT_EQ(test::run_command(test::binary() + " test " + file + " -o " + out.string() +
+                                    " -q --threads 2 --resume " + cp,
+                                &msg),
+              0)
+        << msg;
+    EXPECT_FALSE(fs::exists(cp)); // a finished run needs no checkpoint
+    auto strip = [](nlohmann::json r) {
+      r["provenance"].erase("wall_time_s");
+      r["provenance"].erase("threads");
+      return r;
+    };
+    EXPECT_EQ(strip(read_json_file((out / "results.json").string())).dump(),
+              strip(read_json_file((full / "results.json").string())).dump());
+    for (const char* f : {"history.csv", "cracks.csv", "vtk/grains.pvd"})
+      EXPECT_EQ(test::read_file(out / f), test::read_file(full / f)) << f;
+  }
+}
