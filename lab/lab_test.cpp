@@ -63,7 +63,7 @@ Wall plane_wall(int dim, const std::string& name, const Vec3& p, const Vec3& n, 
   return w;
 }
 
-constexpr double kServoIntegralSteps = 200; ///< integral time of the confining servo [steps]
+constexpr double kServoIntegralSteps = 100; ///< integral time of the confining servo [steps]
 
 double smoothstep(double x) {
   x = std::clamp(x, 0.0, 1.0);
@@ -188,6 +188,7 @@ private:
   void begin_loading();
   void finish(const std::string& why);
   double servo_velocity(std::size_t wall, double target, double area, double stress) const;
+  double follow_velocity(std::size_t k) const;
   double separation() const;
   double lateral_width(int d) const;
   double face_area(std::size_t k) const;
@@ -229,8 +230,8 @@ private:
   double conf_win_sum_ = 0, conf_inst_min_ = 0, conf_inst_max_ = 0;
   bool conf_seen_ = false;
   double conf_peak_min_ = 0, conf_peak_max_ = 0; ///< the band up to the peak
-  std::vector<double> servo_integral_; ///< sum of the confinement error of each wall [Pa]
-  std::int64_t bond_break_events_ = 0; ///< bond_break events seen (each becomes a crack)
+  std::vector<double> servo_integral_;           ///< sum of the confinement error of each wall [Pa]
+  std::int64_t bond_break_events_ = 0;           ///< bond_break events seen (each becomes a crack)
   double next_snapshot_strain_ = 0;
   bool snapshot_due_ = false, peak_snap_due_ = false;
   std::int64_t peak_snap_step_ = -1;
@@ -478,6 +479,37 @@ double Machine::servo_velocity(std::size_t wall, double target, double area, dou
   return std::clamp(v, -vmax, vmax);
 }
 
+double Machine::follow_velocity(std::size_t k) const {
+  // Force-weighted mean velocity, towards the specimen (> 0 inwards), of the grains touching
+  // lateral wall k.
+  const auto wall = static_cast<std::int32_t>(lateral_[k]);
+  const Wall& w = m_.walls[static_cast<std::size_t>(wall)];
+  const auto& cs = m_.contacts();
+  const auto& os = m_.contact_outputs();
+  double fsum = 0, vsum = 0;
+  for (std::size_t ci = 0; ci < cs.size(); ++ci) {
+    if (cs[ci].kind != ContactKind::BallFacet || cs[ci].end2 != wall)
+      continue;
+    const double f = os[ci].force.norm();
+    if (f <= 0)
+      continue;
+    const auto b = static_cast<std::size_t>(cs[ci].end1);
+    const Vec3& vel = m_.balls.vel[b];
+    double inward;
+    if (lateral_axis_[k] < 0) {
+      Vec3 r = m_.balls.pos[b] - w.center;
+      r -= r.dot(w.axis) * w.axis;
+      const double rn = r.norm();
+      inward = rn > 0 ? -vel.dot(r) / rn : 0.0;
+    } else {
+      inward = -lateral_sign_[k] * vel[lateral_axis_[k]];
+    }
+    fsum += f;
+    vsum += f * inward;
+  }
+  return fsum > 0 ? vsum / fsum : 0.0;
+}
+
 void Machine::measure(LabSample& s) const {
   s.step = m_.step();
   s.time = m_.time();
@@ -597,21 +629,21 @@ void Machine::begin_loading() {
 
 void Machine::control() {
   const Vec3 e = unit(axis_);
-  // Confining walls hold the confinement (in every phase). Proportional-integral control: the
-  // proportional part alone lags behind a specimen that dilates steadily (the lag is the
-  // dilation rate over the gain, several % after the peak); the integral of the error, with a
-  // 200-step time constant, removes that lag.
+  // Confining walls hold the confinement (in every phase). Each wall follows the grains that
+  // touch it (feed-forward: the force-weighted mean of their velocity along the wall normal, so a
+  // dilating specimen is followed without a standing error), plus a proportional term that
+  // closes half the stress error per step and a small integral trim (time constant 100 steps,
+  // limited to 5 % of the confinement) against any remaining bias.
   if (servo_integral_.size() != lateral_.size())
     servo_integral_.assign(lateral_.size(), 0.0);
   for (std::size_t k = 0; k < lateral_.size(); ++k) {
     const double stress = lateral_stress_of(k);
-    // Anti-windup: the integral never shifts the target by more than 5 %.
     const double cap = 0.05 * p_.confinement * kServoIntegralSteps;
     servo_integral_[k] = std::clamp(servo_integral_[k] + p_.confinement - stress, -cap, cap);
-    const double v =
-        servo_velocity(static_cast<std::size_t>(lateral_[k]),
-                       p_.confinement + servo_integral_[k] / kServoIntegralSteps, face_area(k),
-                       stress);
+    const double v = servo_velocity(static_cast<std::size_t>(lateral_[k]),
+                                    p_.confinement + servo_integral_[k] / kServoIntegralSteps,
+                                    face_area(k), stress) +
+                     follow_velocity(k);
     Wall& w = m_.walls[static_cast<std::size_t>(lateral_[k])];
     if (lateral_axis_[k] < 0)
       w.radial_velocity = -v;
@@ -819,7 +851,7 @@ nlohmann::json Machine::state() const {
   s["reference"] = vec_json(reference_);
   s["peak"] = {peak_,      peak_strain_, peak_stress_,  peak_force_, peak_lateral_,
                peak_time_, peak_step_,   peak_tension_, peak_shear_};
-  s["confinement_stats"] = {conf_min_,     conf_max_,      conf_sum_,     conf_n_,
+  s["confinement_stats"] = {conf_min_,     conf_max_,      conf_sum_,      conf_n_,
                             conf_win_sum_, conf_win_n_,    conf_inst_min_, conf_inst_max_,
                             conf_seen_,    conf_peak_min_, conf_peak_max_};
   s["bond_break_events"] = bond_break_events_;
@@ -971,12 +1003,18 @@ nlohmann::json Machine::results() const {
           {"instantaneous_min", conf_inst_min_},
           {"instantaneous_max", conf_inst_max_}};
     if (p_.reverse_at_strain > 0) {
-      // Loading and unloading slopes over the same strain range (20-100 % of the reversal).
+      // Loading and unloading slopes over the same strain range (20-100 % of the reversal),
+      // each once the platens run at full speed (after the ramps at the start and the turn).
       std::vector<LabSample> up, down;
       for (const LabSample& s : samples_) {
         if (s.axial_strain < 0.2 * p_.reverse_at_strain)
           continue;
-        (s.step <= reverse_step_ ? up : down).push_back(s);
+        if (s.step <= reverse_step_) {
+          if (s.step >= load_start_step_ + p_.ramp_steps)
+            up.push_back(s);
+        } else if (s.step >= reverse_step_ + p_.ramp_steps) {
+          down.push_back(s);
+        }
       }
       r["youngs_modulus_loading_Pa"] = fit_elastic(up, 1e300, -1e300, 1e300).youngs_modulus;
       r["youngs_modulus_unloading_Pa"] = fit_elastic(down, 1e300, -1e300, 1e300).youngs_modulus;

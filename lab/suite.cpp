@@ -8,11 +8,11 @@
 
 #include <algorithm>
 #include <array>
-#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -43,9 +43,12 @@ std::string read_text(const std::string& path) {
 bool valid_name(const std::string& s) {
   if (s.empty() || s.size() > 64)
     return false;
-  return std::all_of(s.begin(), s.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
-  }) && s[0] != '.';
+  return std::all_of(s.begin(), s.end(),
+                     [](char c) {
+                       return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' ||
+                              c == '.';
+                     }) &&
+         s[0] != '.';
 }
 
 // Least-squares line y = a + b x; returns {a, b, r2}.
@@ -212,8 +215,7 @@ void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
       live.erase(pid);
       --running;
       j.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-      j.seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - j.start).count();
+      j.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - j.start).count();
       if (o.progress)
         std::fprintf(stderr, "[rocklab suite] %s %s in %.1f s\n", j.label.c_str(),
                      j.status == 0 ? "finished" : "FAILED", j.seconds);
@@ -275,8 +277,14 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
     specimen_of[t.specimen_key] = name;
     Job j;
     j.label = "genesis " + name;
-    j.argv = {o.executable, "genesis", material, "-o", out.staged("specimens/" + name).string(),
-              "--threads", std::to_string(threads), "-q"};
+    j.argv = {o.executable,
+              "genesis",
+              material,
+              "-o",
+              out.staged("specimens/" + name).string(),
+              "--threads",
+              std::to_string(threads),
+              "-q"};
     if (!t.shape.is_null())
       j.argv.insert(j.argv.end(), {"--shape", t.shape.dump()});
     if (t.protocol.contains("seed"))
@@ -308,8 +316,8 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
     write_text_file(dir / "protocol.json", p.dump(2) + "\n");
     Job j;
     j.label = "test " + t.name;
-    j.argv = {o.executable,       "test", (dir / "protocol.json").string(), "-o",
-              (dir / "out").string(), "--threads", std::to_string(threads), "-q"};
+    j.argv = {o.executable,           "test",      (dir / "protocol.json").string(), "-o",
+              (dir / "out").string(), "--threads", std::to_string(threads),          "-q"};
     j.log = out.staged("logs/" + t.name + ".log").string();
     jobs.push_back(std::move(j));
   }
@@ -372,51 +380,50 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
       const double v = num(r, key);
       return std::isfinite(v) ? format_double(v) : std::string();
     };
-    csv += t.name + "," + type + ",ok," + f("confinement_Pa") + "," + f("youngs_modulus_Pa") +
-           "," + f("poisson_ratio") + "," + f("peak_stress_Pa") + "," + f("peak_deviator_Pa") +
-           "," + f("tensile_strength_Pa") + "," + r["cracks"]["tension"].dump() + "," +
+    csv += t.name + "," + type + ",ok," + f("confinement_Pa") + "," + f("youngs_modulus_Pa") + "," +
+           f("poisson_ratio") + "," + f("peak_stress_Pa") + "," + f("peak_deviator_Pa") + "," +
+           f("tensile_strength_Pa") + "," + r["cracks"]["tension"].dump() + "," +
            r["cracks"]["shear"].dump() + "," + r["provenance"]["grains"].dump() + "," +
            r["provenance"]["steps"].dump() + "," + format_double(j.seconds) + "\n";
+    tests.push_back(row);
   }
   const Envelope env = fit_envelope(s3, s1);
-  nlohmann::json props{{"youngs_modulus_Pa", or_null(e)},
-                       {"poisson_ratio", or_null(nu)},
-                       {"ucs_Pa", or_null(ucs)},
-                       {"bts_Pa", or_null(bts)},
-                       {"direct_tension_Pa", or_null(dt)},
-                       {"ucs_over_bts", or_null(ucs / bts)},
-                       {"direct_tension_over_bts", or_null(dt / bts)},
-                       {"friction_angle_deg", env.has_mc ? or_null(env.friction_angle_deg)
-                                                         : nlohmann::json(nullptr)},
-                       {"cohesion_Pa", env.has_mc ? or_null(env.cohesion) : nlohmann::json(nullptr)},
-                       {"mohr_coulomb_r2", env.has_mc ? or_null(env.r2_mc) : nlohmann::json(nullptr)},
-                       {"hoek_brown_mi", env.has_hb ? or_null(env.hb_mi) : nlohmann::json(nullptr)},
-                       {"hoek_brown_sigma_c_Pa",
-                        env.has_hb ? or_null(env.hb_sigma_c) : nlohmann::json(nullptr)},
-                       {"envelope_points", env.points}};
-  nlohmann::json summary{
-      {"suite", s.name},
-      {"suite_file", s.file},
-      {"suite_hash", s.text_hash},
-      {"material", s.material.value("name", "")},
-      {"material_file", s.material_file},
-      {"units", "SI (m, kg, s, N, Pa, J); stresses compression positive"},
-      {"properties", props},
-      {"tests", tests},
-      {"parallel_processes", parallel},
-      {"threads_per_process", threads},
-      {"rocklab_version", ROCKLAB_VERSION},
-      {"wall_time_s", std::chrono::duration<double>(clock::now() - t0).count()}};
+  nlohmann::json props{
+      {"youngs_modulus_Pa", or_null(e)},
+      {"poisson_ratio", or_null(nu)},
+      {"ucs_Pa", or_null(ucs)},
+      {"bts_Pa", or_null(bts)},
+      {"direct_tension_Pa", or_null(dt)},
+      {"ucs_over_bts", or_null(ucs / bts)},
+      {"direct_tension_over_bts", or_null(dt / bts)},
+      {"friction_angle_deg",
+       env.has_mc ? or_null(env.friction_angle_deg) : nlohmann::json(nullptr)},
+      {"cohesion_Pa", env.has_mc ? or_null(env.cohesion) : nlohmann::json(nullptr)},
+      {"mohr_coulomb_r2", env.has_mc ? or_null(env.r2_mc) : nlohmann::json(nullptr)},
+      {"hoek_brown_mi", env.has_hb ? or_null(env.hb_mi) : nlohmann::json(nullptr)},
+      {"hoek_brown_sigma_c_Pa", env.has_hb ? or_null(env.hb_sigma_c) : nlohmann::json(nullptr)},
+      {"envelope_points", env.points}};
+  nlohmann::json summary{{"suite", s.name},
+                         {"suite_file", s.file},
+                         {"suite_hash", s.text_hash},
+                         {"material", s.material.value("name", "")},
+                         {"material_file", s.material_file},
+                         {"units", "SI (m, kg, s, N, Pa, J); stresses compression positive"},
+                         {"properties", props},
+                         {"tests", tests},
+                         {"parallel_processes", parallel},
+                         {"threads_per_process", threads},
+                         {"rocklab_version", ROCKLAB_VERSION},
+                         {"wall_time_s", std::chrono::duration<double>(clock::now() - t0).count()}};
   auto cell = [](const nlohmann::json& v) {
     return v.is_number() ? format_double(v.get<double>()) : std::string();
   };
   std::string scsv = "material,youngs_modulus_Pa,poisson_ratio,ucs_Pa,bts_Pa,direct_tension_Pa,"
                      "ucs_over_bts,friction_angle_deg,cohesion_Pa,hoek_brown_mi\n";
   scsv += summary["material"].get<std::string>();
-  for (const char* k : {"youngs_modulus_Pa", "poisson_ratio", "ucs_Pa", "bts_Pa",
-                        "direct_tension_Pa", "ucs_over_bts", "friction_angle_deg", "cohesion_Pa",
-                        "hoek_brown_mi"})
-  {
+  for (const char* k :
+       {"youngs_modulus_Pa", "poisson_ratio", "ucs_Pa", "bts_Pa", "direct_tension_Pa",
+        "ucs_over_bts", "friction_angle_deg", "cohesion_Pa", "hoek_brown_mi"}) {
     scsv += ',';
     scsv += cell(props[k]);
   }
@@ -433,8 +440,8 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
 std::string summary_table(const nlohmann::json& sm) {
   std::string t;
   char line[256];
-  std::snprintf(line, sizeof line, "suite %s   material %s\n", sm["suite"].get<std::string>().c_str(),
-                sm["material"].get<std::string>().c_str());
+  std::snprintf(line, sizeof line, "suite %s   material %s\n",
+                sm["suite"].get<std::string>().c_str(), sm["material"].get<std::string>().c_str());
   t += line;
   t += "test                 type            conf [MPa]  E [GPa]   nu     peak [MPa]  tensile "
        "[MPa]  cracks  time [s]\n";

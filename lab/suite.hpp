@@ -12,10 +12,10 @@
 namespace rocklab {
 
 struct SuiteTest {
-  std::string name;          ///< also the test's folder under OUTDIR/tests
-  nlohmann::json protocol;   ///< the protocol without its specimen
-  nlohmann::json shape;      ///< specimen shape for genesis (null: the card's)
-  std::string specimen_key;  ///< tests with the same key share one specimen
+  std::string name;         ///< also the test's folder under OUTDIR/tests
+  nlohmann::json protocol;  ///< the protocol without its specimen
+  nlohmann::json shape;     ///< specimen shape for genesis (null: the card's)
+  std::string specimen_key; ///< tests with the same key share one specimen
 };
 
 struct Suite {
@@ -23,7 +23,7 @@ struct Suite {
   std::string material_file; ///< the material card (absolute or relative to the working dir)
   nlohmann::json material;   ///< the card as read
   std::vector<SuiteTest> tests;
-  int parallel = 0;          ///< processes at once (0: one per core)
+  int parallel = 0; ///< processes at once (0: one per core)
   std::string text_hash;
 };
 

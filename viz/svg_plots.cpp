@@ -153,57 +153,77 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
 }
 
 std::string crack_map_svg(const Snapshot& snap, const std::string& title) {
-  // View: 2D as is (x right, y up); 3D along y (x right, z up).
+  // View: 2D as is (x right, y up). 3D: a thin section through the centre, seen along y (x right,
+  // z up): the grains and cracks within 10 % of the specimen's y extent of the mid-plane, each
+  // crack drawn as its trace (a segment across the projected normal; a circle when it lies in
+  // the section plane).
   const int vx = 0, vy = snap.dim == 2 ? 1 : 2;
-  double xlo = 1e300, xhi = -1e300, ylo = 1e300, yhi = -1e300;
+  double xlo = 1e300, xhi = -1e300, ylo = 1e300, yhi = -1e300, dlo = 1e300, dhi = -1e300;
   for (std::size_t i = 0; i < snap.pos.size(); ++i) {
     xlo = std::min(xlo, snap.pos[i][vx] - snap.radius[i]);
     xhi = std::max(xhi, snap.pos[i][vx] + snap.radius[i]);
     ylo = std::min(ylo, snap.pos[i][vy] - snap.radius[i]);
     yhi = std::max(yhi, snap.pos[i][vy] + snap.radius[i]);
+    dlo = std::min(dlo, snap.pos[i].y() - snap.radius[i]);
+    dhi = std::max(dhi, snap.pos[i].y() + snap.radius[i]);
   }
   if (xlo > xhi)
-    xlo = 0, xhi = 1, ylo = 0, yhi = 1;
+    xlo = 0, xhi = 1, ylo = 0, yhi = 1, dlo = dhi = 0;
+  const double mid = 0.5 * (dlo + dhi), half = 0.1 * (dhi - dlo);
+  auto in_section = [&](const Vec3& p) { return snap.dim == 2 || std::abs(p.y() - mid) <= half; };
   const double margin = 20, top = 40, maxw = 640, maxh = 800;
   const double scale = std::min(maxw / (xhi - xlo), maxh / (yhi - ylo));
   const double W = (xhi - xlo) * scale + 2 * margin, H = (yhi - ylo) * scale + top + 2 * margin;
   auto X = [&](double v) { return margin + (v - xlo) * scale; };
   auto Y = [&](double v) { return top + margin + (yhi - v) * scale; };
   std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + num(W) + "\" height=\"" +
-                  num(H) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+                  num(H + (snap.dim == 3 ? 16 : 0)) +
+                  "\" font-family=\"sans-serif\" font-size=\"12\">\n";
   s += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
   s += "<text x=\"" + num(W / 2) + "\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">" +
        escape(title) + "</text>\n";
-  s += "<g fill=\"#d9d9d9\" stroke=\"#a0a0a0\" stroke-width=\"0.4\">\n";
-  for (std::size_t i = 0; i < snap.pos.size(); ++i)
+  s += "<g fill=\"#e3e3e3\" stroke=\"#a0a0a0\" stroke-width=\"0.4\">\n";
+  for (std::size_t i = 0; i < snap.pos.size(); ++i) {
+    if (!in_section(snap.pos[i]))
+      continue;
+    // 3D: the grain's cut by the mid-plane (at least a third of its radius, to stay visible)
+    double r = snap.radius[i];
+    if (snap.dim == 3) {
+      const double d = snap.pos[i].y() - mid;
+      r = std::sqrt(std::max(r * r - d * d, r * r / 9));
+    }
     s += "<circle cx=\"" + num(X(snap.pos[i][vx])) + "\" cy=\"" + num(Y(snap.pos[i][vy])) +
-         "\" r=\"" + num(snap.radius[i] * scale) + "\"/>\n";
+         "\" r=\"" + num(r * scale) + "\"/>\n";
+  }
   s += "</g>\n";
+  std::size_t shown = 0;
   for (const CrackGlyph& c : snap.cracks) {
+    if (!in_section(c.position))
+      continue;
+    ++shown;
     const char* color = c.mode == 1 ? "#d62728" : "#1f3fbf";
     const double r = 0.5 * c.size * scale;
-    if (snap.dim == 2) {
-      const double tx = -c.normal.y(), ty = c.normal.x();
-      s += "<line x1=\"" + num(X(c.position.x()) - r * tx) + "\" y1=\"" +
-           num(Y(c.position.y()) + r * ty) + "\" x2=\"" + num(X(c.position.x()) + r * tx) +
-           "\" y2=\"" + num(Y(c.position.y()) - r * ty) + "\" stroke=\"" + color +
-           "\" stroke-width=\"1.5\"/>\n";
-    } else {
-      // A disk of radius r with normal n, seen along y: an ellipse whose minor semi-axis lies
-      // along the projected normal and has length r |n_y|.
-      const double nx = c.normal.x(), nz = c.normal.z();
-      const double len = std::hypot(nx, nz);
-      const double angle = len > 0 ? std::atan2(-nz, nx) * 180 / std::numbers::pi : 0.0;
-      const double minor = std::max(r * std::abs(c.normal.y()), 0.4);
-      s += "<ellipse cx=\"" + num(X(c.position.x())) + "\" cy=\"" + num(Y(c.position.z())) +
-           "\" rx=\"" + num(minor) + "\" ry=\"" + num(r) + "\" transform=\"rotate(" + num(angle) +
-           " " + num(X(c.position.x())) + " " + num(Y(c.position.z())) + ")\" fill=\"" + color +
-           "\" fill-opacity=\"0.5\" stroke=\"" + color + "\" stroke-width=\"0.6\"/>\n";
+    const double px = c.position[vx], py = c.position[vy];
+    const double nx = c.normal[vx], ny = c.normal[vy];
+    const double len = std::hypot(nx, ny);
+    if (len < 0.2) { // (3D) a crack nearly in the section plane
+      s += "<circle cx=\"" + num(X(px)) + "\" cy=\"" + num(Y(py)) + "\" r=\"" + num(r) +
+           "\" fill=\"none\" stroke=\"" + color + "\" stroke-width=\"1\"/>\n";
+      continue;
     }
+    const double tx = -ny / len, ty = nx / len;
+    s += "<line x1=\"" + num(X(px) - r * tx) + "\" y1=\"" + num(Y(py) + r * ty) + "\" x2=\"" +
+         num(X(px) + r * tx) + "\" y2=\"" + num(Y(py) - r * ty) + "\" stroke=\"" + color +
+         "\" stroke-width=\"1.5\"/>\n";
   }
   s += "<text x=\"" + num(margin) + "\" y=\"" + num(H - 6) +
        "\" fill=\"#d62728\">tension</text><text x=\"" + num(margin + 70) + "\" y=\"" + num(H - 6) +
        "\" fill=\"#1f3fbf\">shear</text>\n";
+  if (snap.dim == 3)
+    s += "<text x=\"" + num(margin) + "\" y=\"" + num(H + 10) +
+         "\" fill=\"#555555\">section |y - " + num(1e3 * mid) + " mm| &lt;= " + num(1e3 * half) +
+         " mm: " + std::to_string(shown) + " of " + std::to_string(snap.cracks.size()) +
+         " cracks</text>\n";
   s += "</svg>\n";
   return s;
 }
