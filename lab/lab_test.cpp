@@ -121,6 +121,8 @@ SpecimenSource obtain_specimen(const Protocol& p, const std::atomic<bool>* inter
   MaterialCard card = load_material_card(p.material_file);
   if (!p.shape.is_null())
     card.vessel = shape_from_json(p.shape, card.dim, p.file, "specimen.shape");
+  if (!p.cut.is_null())
+    card.cut = shape_from_json(p.cut, card.dim, p.file, "specimen.cut");
   if (p.seed)
     card.seed = *p.seed;
   GenesisResult g = run_genesis(

@@ -66,6 +66,8 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
         s.fail("material", "\"" + p.material_file + "\" does not exist");
       if (s.has("shape"))
         p.shape = s.raw("shape");
+      if (s.has("cut"))
+        p.cut = s.raw("cut");
     }
     s.finish();
   }

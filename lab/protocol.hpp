@@ -26,6 +26,7 @@ struct Protocol {
   std::string specimen_file;
   std::string material_file;
   nlohmann::json shape;              ///< replaces the card's specimen shape for genesis (or null)
+  nlohmann::json cut;                ///< replaces the card's cut (test shape cut from the block)
   std::optional<std::uint64_t> seed; ///< replaces the card's seed for genesis
   // loading
   double strain_rate = kDefaultStrainRate; ///< total rate: both platens together [1/s]

@@ -143,18 +143,26 @@ Suite load_suite(const std::string& path) {
                             "\"seed\") in the test instead");
     if (tobj.has("shape"))
       t.shape = tobj.raw("shape");
+    if (tobj.has("cut"))
+      t.cut = tobj.raw("cut");
     pj.erase("name");
     pj.erase("shape");
+    pj.erase("cut");
     t.protocol = pj;
     // Validate the protocol now (it will be given its specimen when the suite runs).
     nlohmann::json check = pj;
     check["specimen"] = {{"material", fs::absolute(s.material_file).string()}};
     if (!t.shape.is_null())
       check["specimen"]["shape"] = t.shape;
+    if (!t.cut.is_null())
+      check["specimen"]["cut"] = t.cut;
     const Protocol p = protocol_from_json(check, path, tpath);
     if (!t.shape.is_null())
       shape_from_json(t.shape, s.material.value("dimension", 3), path, tpath + ".shape");
-    t.specimen_key = t.shape.dump() + "|" + (p.seed ? std::to_string(*p.seed) : "card");
+    if (!t.cut.is_null())
+      shape_from_json(t.cut, s.material.value("dimension", 3), path, tpath + ".cut");
+    t.specimen_key =
+        t.shape.dump() + "|" + t.cut.dump() + "|" + (p.seed ? std::to_string(*p.seed) : "card");
     s.tests.push_back(std::move(t));
   }
   if (s.tests.empty())
@@ -277,21 +285,23 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
     specimen_of[t.specimen_key] = name;
     Job j;
     j.label = "genesis " + name;
-    j.argv = {o.executable,
-              "genesis",
-              material,
-              "-o",
-              out.staged("specimens/" + name).string(),
-              "--threads",
-              std::to_string(threads),
-              "-q"};
+    j.argv = {o.executable, "genesis", material, "-o", out.staged("specimens/" + name).string(),
+              "--threads",  "THREADS", "-q"};
     if (!t.shape.is_null())
       j.argv.insert(j.argv.end(), {"--shape", t.shape.dump()});
+    if (!t.cut.is_null())
+      j.argv.insert(j.argv.end(), {"--cut", t.cut.dump()});
     if (t.protocol.contains("seed"))
       j.argv.insert(j.argv.end(), {"--seed", t.protocol["seed"].dump()});
     j.log = out.staged("logs/" + name + ".log").string();
     gen.push_back(std::move(j));
   }
+  // Fewer genesis jobs than processes: each gets a larger share of the cores.
+  const int gen_jobs = std::max(1, std::min(parallel, static_cast<int>(gen.size())));
+  const int gen_threads =
+      o.threads > 0 ? o.threads : std::max(1, static_cast<int>(cores) / gen_jobs);
+  for (Job& j : gen)
+    std::replace(j.argv.begin(), j.argv.end(), std::string("THREADS"), std::to_string(gen_threads));
   run_jobs(gen, parallel, o);
   for (const Job& j : gen)
     if (j.status != 0)
@@ -308,6 +318,8 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
       p["specimen"] = {{"material", material}};
       if (!t.shape.is_null())
         p["specimen"]["shape"] = t.shape;
+      if (!t.cut.is_null())
+        p["specimen"]["cut"] = t.cut;
     }
     if (!p.contains("name"))
       p["name"] = t.name;

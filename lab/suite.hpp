@@ -15,6 +15,7 @@ struct SuiteTest {
   std::string name;         ///< also the test's folder under OUTDIR/tests
   nlohmann::json protocol;  ///< the protocol without its specimen
   nlohmann::json shape;     ///< specimen shape for genesis (null: the card's)
+  nlohmann::json cut;       ///< test shape cut from that block (null: the card's)
   std::string specimen_key; ///< tests with the same key share one specimen
 };
 

@@ -106,7 +106,8 @@ TEST(Specimen, BadFilesFailCleanly) {
     EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
   }
   // A newer version.
-  bytes.replace(bytes.find("\"version\":2"), 11, "\"version\":9");
+  const std::string cur = "\"version\":" + std::to_string(kSpecimenVersion);
+  bytes.replace(bytes.find(cur), cur.size(), "\"version\":99");
   std::ofstream(file, std::ios::binary) << bytes;
   try {
     load_model(file.string());

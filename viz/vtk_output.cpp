@@ -299,7 +299,7 @@ std::vector<std::string> VtkSeries::write_collections() const {
     // same time).
     std::vector<std::pair<double, std::string>> entries;
     for (std::size_t i = 0; i < times_.size(); ++i) {
-      char index[16];
+      char index[32];
       std::snprintf(index, sizeof index, "%04zu", i);
       entries.emplace_back(times_[i], index);
     }

@@ -56,7 +56,7 @@ int run_command(const std::string& scene_file, const std::string& out_dir, bool 
 }
 
 int genesis_command(const std::string& material_file, const std::string& out, bool quiet,
-                    const std::string& shape, std::int64_t seed) {
+                    const std::string& shape, const std::string& cut, std::int64_t seed) {
   rocklab::MaterialCard card = rocklab::load_material_card(material_file);
   if (!shape.empty()) {
     nlohmann::json j;
@@ -66,6 +66,15 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
       throw rocklab::InputError("--shape: not JSON: " + std::string(e.what()));
     }
     card.vessel = rocklab::shape_from_json(j, card.dim, "--shape", "shape");
+  }
+  if (!cut.empty()) {
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(cut);
+    } catch (const std::exception& e) {
+      throw rocklab::InputError("--cut: not JSON: " + std::string(e.what()));
+    }
+    card.cut = rocklab::shape_from_json(j, card.dim, "--cut", "cut");
   }
   if (seed >= 0)
     card.seed = static_cast<std::uint64_t>(seed);
@@ -244,11 +253,13 @@ int main(int argc, char** argv) {
   gen->add_option("-o,--out", specimen_out, "Specimen file to write")->required();
   gen->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
   gen->add_flag("-q,--quiet", quiet, "No progress and no summary");
-  std::string gen_shape;
+  std::string gen_shape, gen_cut;
   std::int64_t gen_seed = -1;
   gen->add_option("--shape", gen_shape,
                   "Replace the card's specimen shape (JSON, e.g. '{\"shape\": \"disk\", "
                   "\"diameter\": 0.05, \"thickness\": 0.025}')");
+  gen->add_option("--cut", gen_cut,
+                  "Replace the card's cut (a test shape cut from the block, JSON)");
   gen->add_option("--seed", gen_seed, "Replace the card's random seed")
       ->check(CLI::NonNegativeNumber);
 
@@ -289,14 +300,14 @@ int main(int argc, char** argv) {
     if (*run)
       return run_command(scene_file, out_dir, quiet);
     if (*gen)
-      return genesis_command(material_file, specimen_out, quiet, gen_shape, gen_seed);
+      return genesis_command(material_file, specimen_out, quiet, gen_shape, gen_cut, gen_seed);
     if (*suite)
       return suite_command(suite_file, suite_out, quiet, threads);
     if (*test)
       return test_command(protocol_file, test_out, quiet, checkpoint_every, resume);
     if (*info) {
       std::printf("rocklab %s\nthreads %d\ncontact models: linear, linearpbond, flatjoint, "
-                  "smoothjoint\nunits: SI\n",
+                  "smoothjoint, hysteretic, powerplastic\nunits: SI\n",
                   ROCKLAB_VERSION, omp_get_max_threads());
       return 0;
     }

@@ -37,11 +37,17 @@ void update_linear_part(const LinearParams& p, LinearState& s, const ContactKine
     s.Fn = s.Fn + p.kn * k.d_dn;
   s.Fn = std::min(s.Fn, 0.0);
 
+  shear_update(p.ks, p.fric, s.Fn, s.Fss, s.Fst, s.E_slip, s.slip, k, events, slip_allowed);
+}
+
+void shear_update(double ks, double fric, double Fn, double& Fss, double& Fst, double& E_slip,
+                  bool& slip, const ContactKinematics& k, EventSink& events,
+                  bool slip_allowed) noexcept {
   // Shear force: trial increment, then the Coulomb limit F_s^mu = -mu Fn.
-  const double F0ss = s.Fss, F0st = s.Fst;
-  double tss = F0ss - p.ks * k.d_dss;
-  double tst = F0st - p.ks * k.d_dst;
-  const double limit = -p.fric * s.Fn;
+  const double F0ss = Fss, F0st = Fst;
+  double tss = F0ss - ks * k.d_dss;
+  double tst = F0st - ks * k.d_dst;
+  const double limit = -fric * Fn;
   const double trial = std::sqrt(tss * tss + tst * tst);
   const bool slipping = slip_allowed && trial > limit;
   if (slipping) {
@@ -49,18 +55,18 @@ void update_linear_part(const LinearParams& p, LinearState& s, const ContactKine
     tss *= scale;
     tst *= scale;
   }
-  s.Fss = tss;
-  s.Fst = tst;
+  Fss = tss;
+  Fst = tst;
   // Slip energy: the part of the shear increment not taken up elastically does friction work
   // (zero by definition while sticking; skipping it then avoids round-off residue).
-  if (slipping && p.ks > 0) {
-    const double dk_ss = -(s.Fss - F0ss) / p.ks, dk_st = -(s.Fst - F0st) / p.ks;
+  if (slipping && ks > 0) {
+    const double dk_ss = -(Fss - F0ss) / ks, dk_st = -(Fst - F0st) / ks;
     const double dmu_ss = k.d_dss - dk_ss, dmu_st = k.d_dst - dk_st;
-    s.E_slip -= 0.5 * ((F0ss + s.Fss) * dmu_ss + (F0st + s.Fst) * dmu_st);
+    E_slip -= 0.5 * ((F0ss + Fss) * dmu_ss + (F0st + Fst) * dmu_st);
   }
-  if (slipping != s.slip) {
+  if (slipping != slip) {
     events.slip_change(slipping);
-    s.slip = slipping;
+    slip = slipping;
   }
 }
 

@@ -68,6 +68,12 @@ void update(LinearContact& c, const ContactKinematics& k, ContactResult& out, Ev
 void update_linear_part(const LinearParams& p, LinearState& s, const ContactKinematics& k,
                         EventSink& events, bool slip_allowed = true) noexcept;
 
+/// The Coulomb shear spring of a point contact (also used by the impact models): incremental
+/// ks, limit mu |Fn| (Fn <= 0 in compression), slip energy, slip_change events.
+void shear_update(double ks, double fric, double Fn, double& Fss, double& Fst, double& E_slip,
+                  bool& slip, const ContactKinematics& k, EventSink& events,
+                  bool slip_allowed = true) noexcept;
+
 inline ContactStiffness stiffness(const LinearContact& c) {
   return {c.p.kn + c.p.ks, c.p.ks, 0.0};
 }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "contact/flat_joint.hpp"
+#include "contact/impact_models.hpp"
 #include "contact/linear.hpp"
 #include "contact/parallel_bond.hpp"
 #include "contact/smooth_joint.hpp"
@@ -16,7 +17,14 @@
 
 namespace rocklab {
 
-enum class ModelKind : std::uint8_t { Linear, PBond, FlatJoint, SmoothJoint };
+enum class ModelKind : std::uint8_t {
+  Linear,
+  PBond,
+  FlatJoint,
+  SmoothJoint,
+  Hysteresis,
+  PowerPlastic
+};
 
 inline constexpr std::string_view model_name(ModelKind k) {
   switch (k) {
@@ -28,6 +36,10 @@ inline constexpr std::string_view model_name(ModelKind k) {
     return "flatjoint";
   case ModelKind::SmoothJoint:
     return "smoothjoint";
+  case ModelKind::Hysteresis:
+    return "hysteretic";
+  case ModelKind::PowerPlastic:
+    return "powerplastic";
   }
   return "unknown";
 }
@@ -39,6 +51,8 @@ struct ModelBatches {
   std::vector<FlatJointContact> flatjoint;
   std::vector<FlatJointElement> fj_elements; ///< elements of all flat joints, contact by contact
   std::vector<SmoothJointContact> smoothjoint;
+  std::vector<HysteresisContact> hysteresis;
+  std::vector<PowerPlasticContact> powerplastic;
 
   void clear() {
     linear.clear();
@@ -46,6 +60,8 @@ struct ModelBatches {
     flatjoint.clear();
     fj_elements.clear();
     smoothjoint.clear();
+    hysteresis.clear();
+    powerplastic.clear();
   }
   std::span<FlatJointElement> elements(const FlatJointContact& c) {
     return {fj_elements.data() + c.elem, c.n_elem};
@@ -57,7 +73,8 @@ struct ModelBatches {
 
 /// Properties a scene assigns to a class of contacts; the alternative selects the model
 /// (same order as ModelKind).
-using ModelProps = std::variant<LinearProps, PBondProps, FlatJointProps, SmoothJointProps>;
+using ModelProps = std::variant<LinearProps, PBondProps, FlatJointProps, SmoothJointProps,
+                                HysteresisProps, PowerPlasticProps>;
 
 inline ModelKind kind_of(const ModelProps& p) {
   return static_cast<ModelKind>(p.index());
@@ -133,6 +150,12 @@ inline std::uint32_t create_contact_data(ModelBatches& b, const ModelProps& prop
     b.smoothjoint.push_back(
         smoothjoint::make(std::get<SmoothJointProps>(props), ci.dim, ci.R1, ci.R2, ci.n, ci.gap));
     return static_cast<std::uint32_t>(b.smoothjoint.size() - 1);
+  case ModelKind::Hysteresis:
+    b.hysteresis.push_back(hysteresis::make(std::get<HysteresisProps>(props)));
+    return static_cast<std::uint32_t>(b.hysteresis.size() - 1);
+  case ModelKind::PowerPlastic:
+    b.powerplastic.push_back(powerplastic::make(std::get<PowerPlasticProps>(props)));
+    return static_cast<std::uint32_t>(b.powerplastic.size() - 1);
   }
   __builtin_unreachable();
 }
@@ -158,6 +181,12 @@ inline std::uint32_t move_contact_data(ModelBatches& to, const ModelBatches& fro
   case ModelKind::SmoothJoint:
     to.smoothjoint.push_back(from.smoothjoint[slot]);
     return static_cast<std::uint32_t>(to.smoothjoint.size() - 1);
+  case ModelKind::Hysteresis:
+    to.hysteresis.push_back(from.hysteresis[slot]);
+    return static_cast<std::uint32_t>(to.hysteresis.size() - 1);
+  case ModelKind::PowerPlastic:
+    to.powerplastic.push_back(from.powerplastic[slot]);
+    return static_cast<std::uint32_t>(to.powerplastic.size() - 1);
   }
   __builtin_unreachable();
 }
@@ -186,6 +215,12 @@ inline void update_contact(ModelBatches& b, ModelKind kind, std::uint32_t slot,
     out = ContactResult{-F.dot(k.n), F.dot(k.s), F.dot(k.t), 0, 0, 0};
     return;
   }
+  case ModelKind::Hysteresis:
+    hysteresis::update(b.hysteresis[slot], k, out, ev);
+    return;
+  case ModelKind::PowerPlastic:
+    powerplastic::update(b.powerplastic[slot], k, out, ev);
+    return;
   }
 }
 
@@ -200,6 +235,10 @@ inline ContactStiffness contact_stiffness(const ModelBatches& b, ModelKind kind,
     return flatjoint::stiffness(b.flatjoint[slot]);
   case ModelKind::SmoothJoint:
     return smoothjoint::stiffness(b.smoothjoint[slot]);
+  case ModelKind::Hysteresis:
+    return hysteresis::stiffness(b.hysteresis[slot]);
+  case ModelKind::PowerPlastic:
+    return powerplastic::stiffness(b.powerplastic[slot]);
   }
   __builtin_unreachable();
 }
@@ -214,6 +253,10 @@ inline ContactEnergy contact_energy(const ModelBatches& b, ModelKind kind, std::
     return flatjoint::energy(b.flatjoint[slot], b.elements(b.flatjoint[slot]));
   case ModelKind::SmoothJoint:
     return smoothjoint::energy(b.smoothjoint[slot]);
+  case ModelKind::Hysteresis:
+    return hysteresis::energy(b.hysteresis[slot]);
+  case ModelKind::PowerPlastic:
+    return powerplastic::energy(b.powerplastic[slot]);
   }
   __builtin_unreachable();
 }
@@ -228,6 +271,10 @@ inline bool contact_keeps_alive(const ModelBatches& b, ModelKind kind, std::uint
     return flatjoint::keeps_alive(b.flatjoint[slot], b.elements(b.flatjoint[slot]));
   case ModelKind::SmoothJoint:
     return smoothjoint::keeps_alive(b.smoothjoint[slot]);
+  case ModelKind::Hysteresis:
+    return hysteresis::keeps_alive(b.hysteresis[slot]);
+  case ModelKind::PowerPlastic:
+    return powerplastic::keeps_alive(b.powerplastic[slot]);
   }
   __builtin_unreachable();
 }

@@ -755,6 +755,8 @@ std::size_t Model::apply_method(ModelKind kind, const std::string& method, doubl
       break;
     }
     case ModelKind::Linear:
+    case ModelKind::Hysteresis:
+    case ModelKind::PowerPlastic:
       break;
     }
     outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);
@@ -779,7 +781,9 @@ std::size_t Model::set_property(ModelKind kind, const std::string& name, double 
     else
       throw unknown();
   } else if ((kind == ModelKind::FlatJoint && name != "fj_fric") ||
-             (kind == ModelKind::SmoothJoint && name != "sj_fric")) {
+             (kind == ModelKind::SmoothJoint && name != "sj_fric") ||
+             (kind == ModelKind::Hysteresis && name != "hys_fric") ||
+             (kind == ModelKind::PowerPlastic && name != "pp_fric")) {
     throw unknown();
   }
   std::size_t count = 0;
@@ -801,6 +805,12 @@ std::size_t Model::set_property(ModelKind kind, const std::string& name, double 
       break;
     case ModelKind::SmoothJoint:
       batches_.smoothjoint[c.slot].fric = value;
+      break;
+    case ModelKind::Hysteresis:
+      batches_.hysteresis[c.slot].fric = value;
+      break;
+    case ModelKind::PowerPlastic:
+      batches_.powerplastic[c.slot].fric = value;
       break;
     }
     outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);

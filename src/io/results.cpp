@@ -79,6 +79,24 @@ nlohmann::json contact_state_json(const ModelBatches& b, const Contact& c, int d
     j["elements"] = std::move(elements);
     return j;
   }
+  case ModelKind::Hysteresis: {
+    const HysteresisContact& h = b.hysteresis[c.slot];
+    return {{"hys_kload", h.k_load},
+            {"hys_kunload", h.k_unload},
+            {"hys_force", {{"Fn", h.Fn}, {"Fss", h.Fss}, {"Fst", h.Fst}}},
+            {"hys_slip", h.slip},
+            {"E_hysteresis", h.E_hys},
+            {"E_slip", h.E_slip}};
+  }
+  case ModelKind::PowerPlastic: {
+    const PowerPlasticContact& pp = b.powerplastic[c.slot];
+    return {{"pp_force", {{"Fn", pp.Fn}, {"Fss", pp.Fss}, {"Fst", pp.Fst}}},
+            {"pp_xmax", pp.x_max},
+            {"pp_fmax", pp.F_max},
+            {"pp_slip", pp.slip},
+            {"E_plastic", pp.E_plastic},
+            {"E_slip", pp.E_slip}};
+  }
   case ModelKind::SmoothJoint: {
     const SmoothJointContact& sj = b.smoothjoint[c.slot];
     return {{"sj_state", sj.state},

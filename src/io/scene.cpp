@@ -392,6 +392,25 @@ ModelProps read_model_props(JsonObject& p, const std::string& model, int dim) {
     p.finish();
     return fj;
   }
+  if (model == "hysteretic") {
+    HysteresisProps h;
+    h.hys_knm = p.number("hys_knm", Range::positive(), std::nullopt, "N/m");
+    h.hys_dampn = p.number("hys_dampn", {0, 1, true, false}, 1.0);
+    h.hys_ks = p.number("hys_ks", Range::non_negative(), 0.0, "N/m");
+    h.hys_fric = p.number("hys_fric", Range::non_negative(), 0.0);
+    p.finish();
+    return h;
+  }
+  if (model == "powerplastic") {
+    PowerPlasticProps pp;
+    pp.pp_kn = p.number("pp_kn", Range::positive(), std::nullopt, "N/m");
+    pp.pp_ks = p.number("pp_ks", Range::non_negative(), 0.0, "N/m");
+    pp.pp_fric = p.number("pp_fric", Range::non_negative(), 0.0);
+    pp.pp_T = p.number("pp_T", Range::positive(), std::numeric_limits<double>::infinity(), "N");
+    pp.pp_b = p.number("pp_b", {1, 1000, false, false}, 1.0);
+    p.finish();
+    return pp;
+  }
   SmoothJointProps sj;
   sj.sj_kn = p.number("sj_kn", Range::non_negative(), 0.0, "Pa/m");
   sj.sj_ks = p.number("sj_ks", Range::non_negative(), 0.0, "Pa/m");
@@ -452,12 +471,12 @@ void read_contact_models(JsonObject& top, Model& m) {
         o.fail("wall", "no wall is named \"" + wname + "\"");
       rule.wall = found;
     }
-    const std::string model =
-        o.choice("model", {"linear", "linearpbond", "flatjoint", "smoothjoint"});
+    const std::string model = o.choice("model", {"linear", "linearpbond", "flatjoint",
+                                                 "smoothjoint", "hysteretic", "powerplastic"});
     if (model == "smoothjoint" && rule.ball_facet)
       o.fail("model", "the smooth-joint model is installed at ball-ball contacts only");
     JsonObject props = o.object("properties");
-    if (model != "flatjoint") {
+    if (model != "flatjoint" && model != "hysteretic" && model != "powerplastic") {
       rule.inherit = props.boolean("inherit", false);
       if (rule.inherit && rule.ball_facet)
         props.fail("inherit", "walls hold no surface properties; inherit on ball-ball rules only");

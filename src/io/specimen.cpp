@@ -95,6 +95,20 @@ template <class A> void io(A& a, SmoothJointProps& p) {
       a(p.sj_rmul), a(p.sj_large), a(p.dip), a(p.ddir), a(p.use_normal), a(p.normal), a(p.bond),
       a(p.bond_gap_lo), a(p.bond_gap_hi);
 }
+template <class A> void io(A& a, HysteresisProps& p) {
+  a(p.hys_knm), a(p.hys_dampn), a(p.hys_ks), a(p.hys_fric);
+}
+template <class A> void io(A& a, PowerPlasticProps& p) {
+  a(p.pp_kn), a(p.pp_ks), a(p.pp_fric), a(p.pp_T), a(p.pp_b);
+}
+template <class A> void io(A& a, HysteresisContact& c) {
+  a(c.k_load), a(c.k_unload), a(c.ks), a(c.fric), a(c.Fn), a(c.Fss), a(c.Fst), a(c.W_normal),
+      a(c.E_hys), a(c.E_slip), a(c.slip);
+}
+template <class A> void io(A& a, PowerPlasticContact& c) {
+  a(c.kn), a(c.ks), a(c.fric), a(c.T), a(c.b), a(c.x_max), a(c.F_max), a(c.x), a(c.Fn), a(c.Fss),
+      a(c.Fst), a(c.W_normal), a(c.E_plastic), a(c.E_slip), a(c.slip);
+}
 template <class A> void io(A& a, ModelProps& p) {
   std::uint8_t index = static_cast<std::uint8_t>(p.index());
   a(index);
@@ -111,6 +125,12 @@ template <class A> void io(A& a, ModelProps& p) {
       break;
     case 3:
       p = SmoothJointProps{};
+      break;
+    case 4:
+      p = HysteresisProps{};
+      break;
+    case 5:
+      p = PowerPlasticProps{};
       break;
     default:
       throw InputError("corrupt specimen body (unknown contact model)");
@@ -217,7 +237,8 @@ template <class A> void Model::serialize(A& a) {
   each(a, rules), each(a, surface);
   each(a, contacts_), each(a, outputs_);
   each(a, batches_.linear), each(a, batches_.pbond), each(a, batches_.flatjoint),
-      each(a, batches_.fj_elements), each(a, batches_.smoothjoint);
+      each(a, batches_.fj_elements), each(a, batches_.smoothjoint), each(a, batches_.hysteresis),
+      each(a, batches_.powerplastic);
   a(time_), a(dt_), a(margin_), a(max_ball_disp_), a(wall_disp_), a(max_speed_), a(dt_stiffness_),
       a(step_), a(initialized_);
   io(a, ledger_);

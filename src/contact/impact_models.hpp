@@ -1,0 +1,124 @@
+// Contact models for impact energy loss (rock-impact-energy thesis, seeds/): the hysteretic
+// damping model (section 4.6, Eq. 21-22) and the elastic-perfectly-plastic power-function model
+// (section 5, Fig. 26, Eq. 23-30). Both act at a point (no moments), carry no tension, and slip
+// with a Coulomb limit in shear. SI units.
+//
+// Stability: the thesis found both models blowing up when one step's overlap was large. Here the
+// time step is estimated from the largest normal stiffness the contact can ever present (the
+// unloading stiffness K_unload, or b k_n for the power branch, whose tangent b F_m / x_m never
+// exceeds b k_n because F_m <= k_n x_m), from the step the contact exists, and the engine's speed
+// cap keeps the overlap taken in one step small against the margin; so a first-step force can
+// never exceed what the stable step allows.
+#pragma once
+
+#include "contact/contact_model.hpp"
+
+#include <cstdint>
+#include <limits>
+
+namespace rocklab {
+
+// ---------------------------------------------------------------- hysteretic damping (4.6)
+
+struct HysteresisProps {
+  double hys_knm = 0;   ///< mean normal stiffness (K_load + K_unload) / 2 [N/m]
+  double hys_dampn = 1; ///< K_load / K_unload, (0, 1] [-]
+  double hys_ks = 0;    ///< shear stiffness [N/m]
+  double hys_fric = 0;  ///< friction coefficient [-]
+};
+
+struct HysteresisContact {
+  double k_load = 0, k_unload = 0, ks = 0, fric = 0; ///< [N/m], [-]
+  double Fn = 0; ///< normal force, <= 0 (compression; tension positive convention) [N]
+  double Fss = 0, Fst = 0;
+  double W_normal = 0; ///< work done on the normal spring so far [J]
+  double E_hys = 0;    ///< dissipated by the hysteresis [J]
+  double E_slip = 0;
+  bool slip = false;
+};
+
+namespace hysteresis {
+
+/// K_load = 2 d k / (1 + d) (Eq. 21), K_unload = 2 k / (1 + d) (Eq. 22), d = hys_dampn.
+HysteresisContact make(const HysteresisProps& p);
+void update(HysteresisContact& c, const ContactKinematics& k, ContactResult& out,
+            EventSink& events) noexcept;
+inline ContactStiffness stiffness(const HysteresisContact& c) {
+  return {c.k_unload + c.ks, c.ks, 0.0};
+}
+inline ContactEnergy energy(const HysteresisContact& c) {
+  ContactEnergy e;
+  if (c.k_unload > 0)
+    e.strain = 0.5 * c.Fn * c.Fn / c.k_unload; // what unloading would give back
+  if (c.ks > 0)
+    e.strain += 0.5 * (c.Fss * c.Fss + c.Fst * c.Fst) / c.ks;
+  e.slip = c.E_slip;
+  e.dashpot = c.E_hys;
+  return e;
+}
+inline bool keeps_alive(const HysteresisContact&) {
+  return false;
+}
+
+} // namespace hysteresis
+
+// ------------------------------------- elastic-perfectly-plastic power function (section 5)
+
+struct PowerPlasticProps {
+  double pp_kn = 0;                                      ///< elastic loading stiffness k_n [N/m]
+  double pp_ks = 0;                                      ///< shear stiffness [N/m]
+  double pp_fric = 0;                                    ///< friction coefficient [-]
+  double pp_T = std::numeric_limits<double>::infinity(); ///< transition force T [N]
+  double pp_b = 1; ///< exponent b of the unloading branch F = a x^b, >= 1 [-]
+};
+
+struct PowerPlasticContact {
+  double kn = 0, ks = 0, fric = 0, T = 0, b = 1;
+  double x_max = 0, F_max = 0; ///< turning point: largest overlap and its force [m], [N]
+  double x = 0;                ///< overlap at the last update [m]
+  double Fn = 0;               ///< normal force, <= 0 compression [N]
+  double Fss = 0, Fst = 0;
+  double W_normal = 0; ///< work done by the normal force on the overlap so far [J]
+  double E_plastic = 0;
+  double E_slip = 0;
+  bool slip = false;
+};
+
+namespace powerplastic {
+
+PowerPlasticContact make(const PowerPlasticProps& p);
+/// Normal force magnitude for overlap x given the turning point (x_m, F_m): beyond the turning
+/// point elastic loading k_n capped at T (perfectly plastic); below it the power branch
+/// F = a x^b with a = F_m / x_m^b (Eq. 23), which returns to the origin.
+double normal_force(const PowerPlasticContact& c, double x, double& x_m, double& F_m) noexcept;
+void update(PowerPlasticContact& c, const ContactKinematics& k, ContactResult& out,
+            EventSink& events) noexcept;
+inline ContactStiffness stiffness(const PowerPlasticContact& c) {
+  const double kmax = c.kn * (c.b > 1 ? c.b : 1.0);
+  return {kmax + c.ks, c.ks, 0.0};
+}
+/// Recoverable energy on the power branch: integral of a x^b from 0 to x = F x / (b + 1)
+/// (Eq. 28); plastic = work done - recoverable.
+inline double recoverable(const PowerPlasticContact& c) {
+  return -c.Fn * c.x / (c.b + 1);
+}
+inline ContactEnergy energy(const PowerPlasticContact& c) {
+  ContactEnergy e;
+  e.strain = recoverable(c);
+  if (c.ks > 0)
+    e.strain += 0.5 * (c.Fss * c.Fss + c.Fst * c.Fst) / c.ks;
+  e.slip = c.E_slip;
+  e.plastic = c.E_plastic;
+  return e;
+}
+inline bool keeps_alive(const PowerPlasticContact&) {
+  return false;
+}
+/// Closed-form normal restitution of one impact (Eq. 25-30) of mass m at speed v on a rigid
+/// obstacle: sqrt(2 / (b + 1)) sqrt((g + 1) / (g + 2)), g = e / p, e = T / k_n; without
+/// plastic flow (1/2 m v^2 <= T^2 / (2 k_n)) sqrt(2 / (b + 1)).
+double restitution(double m, double v, double kn, double T, double b);
+
+} // namespace powerplastic
+
+} // namespace rocklab

@@ -1,0 +1,133 @@
+// Impact contact models of the rock-impact thesis: restitution of a ball on a rigid facet against
+// the closed forms (hysteretic: sqrt(K_load / K_unload); elastic-perfectly-plastic power
+// function: Eq. 30), energy balance, and stability at the automatic time step.
+#include "helpers.hpp"
+
+#include "contact/registry.hpp"
+
+#include <cmath>
+
+using namespace rocklab;
+using rocklab::test::near_rel;
+
+namespace {
+
+struct Impact {
+  double restitution = 0; ///< rebound speed / impact speed
+  double balance_rel = 0; ///< |energy balance error| / initial kinetic energy
+  double plastic = 0;     ///< dissipated by the contact [J]
+  double kinetic0 = 0;    ///< [J]
+  double max_force = 0;   ///< [N]
+  long steps_in_contact = 0;
+};
+
+// A 3D ball (R = 0.04 m, 2600 kg/m3, the thesis' test particle) thrown at speed v onto a facet;
+// no gravity, no damping; automatic time step (safety factor 0.08).
+Impact impact(const ModelProps& props, double v, double safety = 0.08) {
+  Model m;
+  m.settings.dim = 3;
+  m.settings.local_damping = 0;
+  m.settings.gravity = Vec3::Zero();
+  // An impact needs tens of cycles in contact (thesis section 5.1): a tenth of the quasi-static
+  // step factor.
+  m.settings.timestep_safety = safety;
+  const double R = 0.04;
+  m.walls.push_back(test::plane_wall(3, Vec3::Zero(), Vec3::UnitZ(), 1.0));
+  const std::size_t b = m.balls.add(3, 1, Vec3(0, 0, R + 1e-4), R, 2600, m.group_index("rock"));
+  m.balls.vel[b] = Vec3(0, 0, -v);
+  ModelRule rule;
+  rule.ball_facet = true;
+  rule.props = props;
+  m.rules.push_back(rule);
+  m.initialize();
+  Impact r;
+  r.kinetic0 = 0.5 * m.balls.mass[b] * v * v;
+  bool touched = false;
+  for (long k = 0; k < 20'000'000; ++k) {
+    m.cycle(1);
+    const bool contact = !m.contacts().empty() && m.contacts()[0].gap < 0;
+    if (contact) {
+      touched = true;
+      ++r.steps_in_contact;
+      r.max_force = std::max(r.max_force, m.contact_outputs()[0].force.norm());
+    } else if (touched) {
+      break;
+    }
+  }
+  r.restitution = m.balls.vel[b].z() / v;
+  const EnergyLedger e = m.energy();
+  r.plastic = e.plastic + e.dashpot;
+  r.balance_rel = std::abs(e.balance_error()) / r.kinetic0;
+  return r;
+}
+
+PowerPlasticProps power(double kn, double T, double b) {
+  PowerPlasticProps p;
+  p.pp_kn = kn;
+  p.pp_ks = 0.15 * kn;
+  p.pp_fric = 0.6;
+  p.pp_T = T;
+  p.pp_b = b;
+  return p;
+}
+
+} // namespace
+
+TEST(ImpactModels, PowerFunctionRestitutionMatchesEquation30) {
+  // The thesis' Fig. 40 contact: K = 1e6 N/m, T = 4e3 N (elastic displacement e = 4 mm).
+  const double kn = 1e6, T = 4e3;
+  const double mass = 2600 * 4.0 / 3.0 * M_PI * std::pow(0.04, 3);
+  for (double b : {1.0, 2.0, 5.0, 10.0, 30.0})
+    for (double v : {2.0, 6.0, 10.0, 15.0}) {
+      const Impact r = impact(power(kn, T, b), v);
+      const double expect = powerplastic::restitution(mass, v, kn, T, b);
+      EXPECT_TRUE(near_rel(r.restitution, expect, 0.01)) << "b " << b << " v " << v;
+      EXPECT_LT(r.max_force, T * (1 + 1e-12)) << "the transition force caps the load";
+      EXPECT_LT(r.balance_rel, 1e-3) << "b " << b << " v " << v;
+      // The energy lost is what the restitution says.
+      EXPECT_NEAR(r.plastic / r.kinetic0, 1 - r.restitution * r.restitution, 2e-3);
+      EXPECT_GT(r.steps_in_contact, 20); // enough cycles per impact (thesis section 5.1)
+    }
+}
+
+TEST(ImpactModels, TriangularLimitsAreOneAndRootHalf) {
+  // b = 1: without plastic flow the unloading line is the loading line (restitution 1); when the
+  // plastic displacement dominates (T tiny, g = e / p -> 0) Eq. 30 gives sqrt(0.5), the
+  // triangular model's minimum of thesis section 5.1.
+  EXPECT_TRUE(near_rel(impact(power(1e6, 1e12, 1.0), 5.0).restitution, 1.0, 1e-3));
+  // T = 100 N at 2 m/s: p = 14 mm of plastic flow against e = 0.1 mm, g = 0.007.
+  const Impact r = impact(power(1e6, 100.0, 1.0), 2.0);
+  EXPECT_TRUE(near_rel(r.restitution, std::sqrt(0.5), 0.01));
+  const double mass = 2600 * 4.0 / 3.0 * M_PI * std::pow(0.04, 3);
+  EXPECT_TRUE(
+      near_rel(r.restitution, powerplastic::restitution(mass, 2.0, 1e6, 100.0, 1.0), 0.005));
+}
+
+TEST(ImpactModels, HysteresisRestitutionIsRootOfStiffnessRatio) {
+  for (double d : {0.1, 0.25, 0.5, 0.8, 1.0})
+    for (double v : {1.0, 10.0}) {
+      HysteresisProps h;
+      h.hys_knm = 6.4e7;
+      h.hys_dampn = d;
+      h.hys_ks = 9.6e6;
+      h.hys_fric = 0.5;
+      const Impact r = impact(h, v);
+      EXPECT_TRUE(near_rel(r.restitution, std::sqrt(d), 0.01)) << "dampn " << d << " v " << v;
+      EXPECT_LT(r.balance_rel, 1e-3);
+    }
+}
+
+TEST(ImpactModels, StiffContactsStayStableAtTheAutomaticTimeStep) {
+  // The thesis' blow-up case: a stiff contact (6.4e10 N/m) hit fast. The rebound may never be
+  // faster than the impact.
+  HysteresisProps h;
+  h.hys_knm = 6.4e10;
+  h.hys_dampn = 0.3;
+  for (double safety : {0.08, 0.8})
+    for (double v : {1.0, 15.0}) {
+      EXPECT_LE(impact(h, v, safety).restitution, 1.0);
+      EXPECT_LE(impact(power(6.4e10, 4e3, 8.0), v, safety).restitution, 1.0);
+      // the elastic-power model (no transition force) that blew up in the thesis
+      EXPECT_LE(impact(power(6.4e10, 1e15, 2.0), v, safety).restitution, 1.0);
+    }
+}
