@@ -131,3 +131,76 @@ TEST(ImpactModels, StiffContactsStayStableAtTheAutomaticTimeStep) {
       EXPECT_LE(impact(power(6.4e10, 1e15, 2.0), v, safety).restitution, 1.0);
     }
 }
+
+namespace {
+
+// Two bonded spheres (R = 1 cm) touching along z; the upper one is driven at velocity v (both
+// fixed otherwise). Returns the largest tensile and shear force seen and the bond_break events.
+struct BondRun {
+  double max_tension = 0, max_shear = 0, force_after = -1;
+  std::vector<Event> events;
+};
+
+BondRun drive_bonded_pair(const Vec3& v, double tenf, double shearf, double kn, double steps) {
+  Model m;
+  m.settings.dim = 3;
+  m.settings.gravity = Vec3::Zero();
+  m.settings.local_damping = 0;
+  m.settings.timestep = 1e-6;
+  const double R = 0.01;
+  const auto g = m.group_index("rock");
+  m.balls.add(3, 1, Vec3::Zero(), R, 2600, g);
+  m.balls.add(3, 2, Vec3(0, 0, 2 * R), R, 2600, g);
+  for (std::size_t i = 0; i < 2; ++i)
+    m.balls.fixity[i] = 0x3f; // every DOF fixed
+  m.balls.vel[1] = v;
+  ContactBondProps p;
+  p.linear.kn = kn;
+  p.linear.ks = kn;
+  p.linear.fric = 0.5;
+  p.cb_tenf = tenf;
+  p.cb_shearf = shearf;
+  ModelRule rule;
+  rule.props = p;
+  m.rules.push_back(rule);
+  m.initialize();
+  BondRun r;
+  for (int k = 0; k < steps; ++k) {
+    m.cycle(1);
+    m.drain_events(r.events);
+    if (m.contacts().empty())
+      break;
+    const ContactOutput& o = m.contact_outputs()[0];
+    const Vec3 n = m.contacts()[0].n;
+    const double fn = o.force.dot(n); // > 0: pulls ball 2 back towards ball 1 (tension)
+    const double fs = (o.force - o.force.dot(n) * n).norm();
+    r.max_tension = std::max(r.max_tension, -fn);
+    r.max_shear = std::max(r.max_shear, fs);
+    r.force_after = o.force.norm();
+  }
+  std::erase_if(r.events, [](const Event& e) { return e.type != EventType::BondBreak; });
+  return r;
+}
+
+} // namespace
+
+TEST(ContactBond, BreaksInTensionAtItsNormalStrength) {
+  const double kn = 1e8, v = 0.01, tenf = 500;
+  const BondRun r = drive_bonded_pair(Vec3(0, 0, v), tenf, 1e9, kn, 2000);
+  ASSERT_EQ(r.events.size(), 1u);
+  EXPECT_EQ(r.events[0].mode, 1);
+  // The tension grows by kn v dt per step and never reaches the strength while bonded.
+  EXPECT_LT(std::abs(r.max_tension), tenf);
+  EXPECT_GT(std::abs(r.max_tension), tenf - kn * v * 1e-6 * 1.01);
+  EXPECT_EQ(r.force_after, 0.0); // no force once broken and open
+}
+
+TEST(ContactBond, BreaksInShearWithoutSlippingFirst) {
+  const double kn = 1e8, v = 0.01, shearf = 300;
+  const BondRun r = drive_bonded_pair(Vec3(v, 0, 0), 1e9, shearf, kn, 2000);
+  ASSERT_EQ(r.events.size(), 1u);
+  EXPECT_EQ(r.events[0].mode, 2);
+  // Bonded: no Coulomb limit (zero normal force would allow no shear at all).
+  EXPECT_GT(r.max_shear, shearf - kn * v * 1e-6 * 1.01);
+  EXPECT_LT(r.max_shear, shearf);
+}

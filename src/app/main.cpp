@@ -307,7 +307,7 @@ int main(int argc, char** argv) {
       return test_command(protocol_file, test_out, quiet, checkpoint_every, resume);
     if (*info) {
       std::printf("rocklab %s\nthreads %d\ncontact models: linear, linearpbond, flatjoint, "
-                  "smoothjoint, hysteretic, powerplastic\nunits: SI\n",
+                  "smoothjoint, hysteretic, powerplastic, contactbond\nunits: SI\n",
                   ROCKLAB_VERSION, omp_get_max_threads());
       return 0;
     }

@@ -7,6 +7,63 @@
 
 namespace rocklab {
 
+namespace contactbond {
+
+ContactBondContact make(const ContactBondProps& p, int dim, double R1, double R2, bool ball_facet,
+                        double gap) {
+  ContactBondContact c;
+  c.lin.p = linear::make_params(p.linear, dim, R1, R2, ball_facet);
+  c.lin.p.lin_mode = 0; // the bond's normal force is the absolute spring force
+  c.tenf = p.cb_tenf;
+  c.shearf = p.cb_shearf;
+  if (p.bond && gap >= p.bond_gap_lo && gap <= p.bond_gap_hi)
+    c.state = 3;
+  return c;
+}
+
+void update(ContactBondContact& c, const ContactKinematics& k, ContactResult& out,
+            EventSink& events) noexcept {
+  if (c.state != 3) {
+    linear::update(c.lin, k, out, events);
+    return;
+  }
+  LinearState& s = c.lin.s;
+  const LinearParams& p = c.lin.p;
+  // Bonded: the normal spring carries tension too; shear without slip (section 4.4).
+  s.Fn = p.kn * (k.gap - p.rgap);
+  linear::shear_update(p.ks, p.fric, s.Fn, s.Fss, s.Fst, s.E_slip, s.slip, k, events, false);
+  const double Fs = std::sqrt(s.Fss * s.Fss + s.Fst * s.Fst);
+  int mode = 0;
+  double strength = 0;
+  if (s.Fn >= c.tenf) {
+    mode = 1;
+    strength = c.tenf;
+  } else if (Fs >= c.shearf) {
+    mode = 2;
+    strength = c.shearf;
+  }
+  if (mode != 0) {
+    Event e;
+    e.type = EventType::BondBreak;
+    e.mode = mode;
+    e.strength = strength;
+    e.energy = linear::energy(c.lin).strain;
+    e.size = 0; // a point bond
+    events.raise(e);
+    c.state = static_cast<std::uint8_t>(mode);
+    if (mode == 1 || s.Fn > 0) {
+      s.Fn = s.Fss = s.Fst = 0;
+    } else if (Fs > -p.fric * s.Fn) { // the friction limit takes over
+      const double scale = -p.fric * s.Fn / Fs;
+      s.Fss *= scale;
+      s.Fst *= scale;
+    }
+  }
+  out = ContactResult{s.Fn, s.Fss, s.Fst, 0, 0, 0};
+}
+
+} // namespace contactbond
+
 namespace hysteresis {
 
 HysteresisContact make(const HysteresisProps& p) {

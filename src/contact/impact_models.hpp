@@ -12,11 +12,56 @@
 #pragma once
 
 #include "contact/contact_model.hpp"
+#include "contact/linear.hpp"
 
 #include <cstdint>
 #include <limits>
 
 namespace rocklab {
+
+// ------------------------------------------------------------------- contact bond (4.3-4.4)
+
+/// The contact bond: the linear model plus a bond at the contact point with normal and shear
+/// strengths in force units. While bonded: tension allowed, no slip; breaks in tension when the
+/// tensile force reaches cb_tenf (forces then zero), in shear when the shear force reaches
+/// cb_shearf (forces kept if compressive and within the friction limit, else the Coulomb limit
+/// applies). Unbonded: the linear model.
+struct ContactBondProps {
+  LinearProps linear;
+  double cb_tenf = 0;   ///< normal (tensile) bond strength [N]
+  double cb_shearf = 0; ///< shear bond strength [N]
+  bool bond = true;     ///< bond when the contact is created (if the gap is within the range)
+  double bond_gap_lo = -1e300, bond_gap_hi = 0; ///< [m]
+};
+
+struct ContactBondContact {
+  LinearContact lin;
+  double tenf = 0, shearf = 0; ///< [N]
+  std::uint8_t state = 0;      ///< 0 never bonded, 1 broke in tension, 2 broke in shear, 3 bonded
+};
+
+namespace contactbond {
+
+ContactBondContact make(const ContactBondProps& p, int dim, double R1, double R2, bool ball_facet,
+                        double gap);
+void update(ContactBondContact& c, const ContactKinematics& k, ContactResult& out,
+            EventSink& events) noexcept;
+inline ContactStiffness stiffness(const ContactBondContact& c) {
+  return linear::stiffness(c.lin);
+}
+inline ContactEnergy energy(const ContactBondContact& c) {
+  ContactEnergy e = linear::energy(c.lin);
+  if (c.state == 3) { // the bonded spring's energy is bond energy (thesis section 3.4)
+    e.bond_strain = e.strain;
+    e.strain = 0;
+  }
+  return e;
+}
+inline bool keeps_alive(const ContactBondContact& c) {
+  return c.state == 3;
+}
+
+} // namespace contactbond
 
 // ---------------------------------------------------------------- hysteretic damping (4.6)
 

@@ -23,7 +23,8 @@ enum class ModelKind : std::uint8_t {
   FlatJoint,
   SmoothJoint,
   Hysteresis,
-  PowerPlastic
+  PowerPlastic,
+  ContactBond
 };
 
 inline constexpr std::string_view model_name(ModelKind k) {
@@ -40,6 +41,8 @@ inline constexpr std::string_view model_name(ModelKind k) {
     return "hysteretic";
   case ModelKind::PowerPlastic:
     return "powerplastic";
+  case ModelKind::ContactBond:
+    return "contactbond";
   }
   return "unknown";
 }
@@ -53,6 +56,7 @@ struct ModelBatches {
   std::vector<SmoothJointContact> smoothjoint;
   std::vector<HysteresisContact> hysteresis;
   std::vector<PowerPlasticContact> powerplastic;
+  std::vector<ContactBondContact> contactbond;
 
   void clear() {
     linear.clear();
@@ -62,6 +66,7 @@ struct ModelBatches {
     smoothjoint.clear();
     hysteresis.clear();
     powerplastic.clear();
+    contactbond.clear();
   }
   std::span<FlatJointElement> elements(const FlatJointContact& c) {
     return {fj_elements.data() + c.elem, c.n_elem};
@@ -74,7 +79,7 @@ struct ModelBatches {
 /// Properties a scene assigns to a class of contacts; the alternative selects the model
 /// (same order as ModelKind).
 using ModelProps = std::variant<LinearProps, PBondProps, FlatJointProps, SmoothJointProps,
-                                HysteresisProps, PowerPlasticProps>;
+                                HysteresisProps, PowerPlasticProps, ContactBondProps>;
 
 inline ModelKind kind_of(const ModelProps& p) {
   return static_cast<ModelKind>(p.index());
@@ -114,6 +119,8 @@ inline void inherit_properties(ModelProps& props, const SurfaceProps& a, const S
     linear_part(*l);
   else if (auto* pb = std::get_if<PBondProps>(&props))
     linear_part(pb->linear);
+  else if (auto* cb = std::get_if<ContactBondProps>(&props))
+    linear_part(cb->linear);
   else if (auto* sj = std::get_if<SmoothJointProps>(&props)) {
     series(sj->sj_kn, a.sj_kn, b.sj_kn);
     series(sj->sj_ks, a.sj_ks, b.sj_ks);
@@ -156,6 +163,10 @@ inline std::uint32_t create_contact_data(ModelBatches& b, const ModelProps& prop
   case ModelKind::PowerPlastic:
     b.powerplastic.push_back(powerplastic::make(std::get<PowerPlasticProps>(props)));
     return static_cast<std::uint32_t>(b.powerplastic.size() - 1);
+  case ModelKind::ContactBond:
+    b.contactbond.push_back(contactbond::make(std::get<ContactBondProps>(props), ci.dim, ci.R1,
+                                              ci.R2, ci.ball_facet, ci.gap));
+    return static_cast<std::uint32_t>(b.contactbond.size() - 1);
   }
   __builtin_unreachable();
 }
@@ -187,6 +198,9 @@ inline std::uint32_t move_contact_data(ModelBatches& to, const ModelBatches& fro
   case ModelKind::PowerPlastic:
     to.powerplastic.push_back(from.powerplastic[slot]);
     return static_cast<std::uint32_t>(to.powerplastic.size() - 1);
+  case ModelKind::ContactBond:
+    to.contactbond.push_back(from.contactbond[slot]);
+    return static_cast<std::uint32_t>(to.contactbond.size() - 1);
   }
   __builtin_unreachable();
 }
@@ -221,6 +235,9 @@ inline void update_contact(ModelBatches& b, ModelKind kind, std::uint32_t slot,
   case ModelKind::PowerPlastic:
     powerplastic::update(b.powerplastic[slot], k, out, ev);
     return;
+  case ModelKind::ContactBond:
+    contactbond::update(b.contactbond[slot], k, out, ev);
+    return;
   }
 }
 
@@ -239,6 +256,8 @@ inline ContactStiffness contact_stiffness(const ModelBatches& b, ModelKind kind,
     return hysteresis::stiffness(b.hysteresis[slot]);
   case ModelKind::PowerPlastic:
     return powerplastic::stiffness(b.powerplastic[slot]);
+  case ModelKind::ContactBond:
+    return contactbond::stiffness(b.contactbond[slot]);
   }
   __builtin_unreachable();
 }
@@ -257,6 +276,8 @@ inline ContactEnergy contact_energy(const ModelBatches& b, ModelKind kind, std::
     return hysteresis::energy(b.hysteresis[slot]);
   case ModelKind::PowerPlastic:
     return powerplastic::energy(b.powerplastic[slot]);
+  case ModelKind::ContactBond:
+    return contactbond::energy(b.contactbond[slot]);
   }
   __builtin_unreachable();
 }
@@ -275,6 +296,8 @@ inline bool contact_keeps_alive(const ModelBatches& b, ModelKind kind, std::uint
     return hysteresis::keeps_alive(b.hysteresis[slot]);
   case ModelKind::PowerPlastic:
     return powerplastic::keeps_alive(b.powerplastic[slot]);
+  case ModelKind::ContactBond:
+    return contactbond::keeps_alive(b.contactbond[slot]);
   }
   __builtin_unreachable();
 }

@@ -754,6 +754,12 @@ std::size_t Model::apply_method(ModelKind kind, const std::string& method, doubl
         smoothjoint::set_force(sj, outputs_[ci].force);
       break;
     }
+    case ModelKind::ContactBond:
+      if (method == "bond")
+        batches_.contactbond[c.slot].state = 3;
+      else
+        batches_.contactbond[c.slot].state = 0;
+      break;
     case ModelKind::Linear:
     case ModelKind::Hysteresis:
     case ModelKind::PowerPlastic:
@@ -771,7 +777,7 @@ std::size_t Model::set_property(ModelKind kind, const std::string& name, double 
                                  std::string(model_name(kind)) + "'");
   };
   double LinearParams::*linear_field = nullptr;
-  if (kind == ModelKind::Linear || kind == ModelKind::PBond) {
+  if (kind == ModelKind::Linear || kind == ModelKind::PBond || kind == ModelKind::ContactBond) {
     if (name == "fric")
       linear_field = &LinearParams::fric;
     else if (name == "kn" && kind == ModelKind::Linear)
@@ -808,6 +814,9 @@ std::size_t Model::set_property(ModelKind kind, const std::string& name, double 
       break;
     case ModelKind::Hysteresis:
       batches_.hysteresis[c.slot].fric = value;
+      break;
+    case ModelKind::ContactBond:
+      batches_.contactbond[c.slot].lin.p.*linear_field = value;
       break;
     case ModelKind::PowerPlastic:
       batches_.powerplastic[c.slot].fric = value;

@@ -79,6 +79,14 @@ nlohmann::json contact_state_json(const ModelBatches& b, const Contact& c, int d
     j["elements"] = std::move(elements);
     return j;
   }
+  case ModelKind::ContactBond: {
+    const ContactBondContact& cb = b.contactbond[c.slot];
+    nlohmann::json j = linear_json(cb.lin.p, cb.lin.s);
+    j["cb_state"] = cb.state;
+    j["cb_tenf"] = cb.tenf;
+    j["cb_shearf"] = cb.shearf;
+    return j;
+  }
   case ModelKind::Hysteresis: {
     const HysteresisContact& h = b.hysteresis[c.slot];
     return {{"hys_kload", h.k_load},

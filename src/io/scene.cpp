@@ -392,6 +392,15 @@ ModelProps read_model_props(JsonObject& p, const std::string& model, int dim) {
     p.finish();
     return fj;
   }
+  if (model == "contactbond") {
+    ContactBondProps cb;
+    cb.linear = read_linear_props(p, false);
+    cb.cb_tenf = p.number("cb_tenf", Range::non_negative(), 0.0, "N");
+    cb.cb_shearf = p.number("cb_shearf", Range::non_negative(), 0.0, "N");
+    read_bond(p, true, cb.bond, cb.bond_gap_lo, cb.bond_gap_hi);
+    p.finish();
+    return cb;
+  }
   if (model == "hysteretic") {
     HysteresisProps h;
     h.hys_knm = p.number("hys_knm", Range::positive(), std::nullopt, "N/m");
@@ -687,10 +696,12 @@ Scene load_scene(const std::string& path) {
     for (const auto& [jm, mpath] : run.array("methods", false)) {
       JsonObject mo(*jm, path, mpath);
       MethodCall mc;
-      const std::string model = mo.choice("model", {"linearpbond", "flatjoint", "smoothjoint"});
-      mc.model = model == "linearpbond"
-                     ? ModelKind::PBond
-                     : (model == "flatjoint" ? ModelKind::FlatJoint : ModelKind::SmoothJoint);
+      const std::string model =
+          mo.choice("model", {"linearpbond", "flatjoint", "smoothjoint", "contactbond"});
+      mc.model = model == "linearpbond"   ? ModelKind::PBond
+                 : model == "flatjoint"   ? ModelKind::FlatJoint
+                 : model == "contactbond" ? ModelKind::ContactBond
+                                          : ModelKind::SmoothJoint;
       mc.method = model == "smoothjoint" ? mo.choice("method", {"bond", "unbond", "sj_setforce"})
                                          : mo.choice("method", {"bond", "unbond"});
       if (mo.has("gap")) {

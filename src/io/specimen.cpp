@@ -109,6 +109,10 @@ template <class A> void io(A& a, PowerPlasticContact& c) {
   a(c.kn), a(c.ks), a(c.fric), a(c.T), a(c.b), a(c.x_max), a(c.F_max), a(c.x), a(c.Fn), a(c.Fss),
       a(c.Fst), a(c.W_normal), a(c.E_plastic), a(c.E_slip), a(c.slip);
 }
+template <class A> void io(A& a, ContactBondProps& p) {
+  io(a, p.linear);
+  a(p.cb_tenf), a(p.cb_shearf), a(p.bond), a(p.bond_gap_lo), a(p.bond_gap_hi);
+}
 template <class A> void io(A& a, ModelProps& p) {
   std::uint8_t index = static_cast<std::uint8_t>(p.index());
   a(index);
@@ -132,6 +136,9 @@ template <class A> void io(A& a, ModelProps& p) {
     case 5:
       p = PowerPlasticProps{};
       break;
+    case 6:
+      p = ContactBondProps{};
+      break;
     default:
       throw InputError("corrupt specimen body (unknown contact model)");
     }
@@ -147,6 +154,10 @@ template <class A> void io(A& a, LinearState& s) {
 }
 template <class A> void io(A& a, LinearContact& c) {
   io(a, c.p), io(a, c.s);
+}
+template <class A> void io(A& a, ContactBondContact& c) {
+  io(a, c.lin);
+  a(c.tenf), a(c.shearf), a(c.state);
 }
 template <class A> void io(A& a, PBondContact& c) {
   io(a, c.lp), io(a, c.ls);
@@ -238,7 +249,7 @@ template <class A> void Model::serialize(A& a) {
   each(a, contacts_), each(a, outputs_);
   each(a, batches_.linear), each(a, batches_.pbond), each(a, batches_.flatjoint),
       each(a, batches_.fj_elements), each(a, batches_.smoothjoint), each(a, batches_.hysteresis),
-      each(a, batches_.powerplastic);
+      each(a, batches_.powerplastic), each(a, batches_.contactbond);
   a(time_), a(dt_), a(margin_), a(max_ball_disp_), a(wall_disp_), a(max_speed_), a(dt_stiffness_),
       a(step_), a(initialized_);
   io(a, ledger_);
