@@ -64,6 +64,9 @@ Wall plane_wall(int dim, const std::string& name, const Vec3& p, const Vec3& n, 
 }
 
 constexpr double kServoIntegralSteps = 100; ///< integral time of the confining servo [steps]
+/// Servo gain: the fraction of the stress error closed per step, from the stiffness of the wall's
+/// contacts (1: the whole error, the fastest stable proportional control for a stiff contact).
+constexpr double kServoGain = 1.0;
 
 double smoothstep(double x) {
   x = std::clamp(x, 0.0, 1.0);
@@ -467,8 +470,8 @@ double Machine::current_area(double lateral_strain) const {
 }
 
 double Machine::servo_velocity(std::size_t wall, double target, double area, double stress) const {
-  // Close half the stress error per step (0.5 A / (sum k dt)), capped at 0.1 % of a mean grain
-  // radius per step. > 0 moves the wall into the specimen.
+  // Close the stress error in one step (kServoGain A / (sum k dt)), capped at 0.1 % of a mean
+  // grain radius per step. > 0 moves the wall into the specimen.
   double ksum = 0;
   const auto& cs = m_.contacts();
   const auto& os = m_.contact_outputs();
@@ -477,7 +480,7 @@ double Machine::servo_velocity(std::size_t wall, double target, double area, dou
       ksum += os[ci].stiff.k_tran;
   const double dt = std::max(m_.timestep(), 1e-15);
   const double vmax = 1e-3 * r_avg_ / dt;
-  const double v = ksum > 0 ? 0.5 * area / (ksum * dt) * (target - stress) : vmax;
+  const double v = ksum > 0 ? kServoGain * area / (ksum * dt) * (target - stress) : vmax;
   return std::clamp(v, -vmax, vmax);
 }
 
@@ -634,7 +637,7 @@ void Machine::control() {
   // Confining walls hold the confinement (in every phase). Each wall follows the grains that
   // touch it (feed-forward: the force-weighted mean of their velocity along the wall normal, so a
   // dilating specimen is followed without a standing error), plus a proportional term that
-  // closes half the stress error per step and a small integral trim (time constant 100 steps,
+  // closes the whole stress error in one step and a small integral trim (time constant 100 steps,
   // limited to 5 % of the confinement) against any remaining bias.
   if (servo_integral_.size() != lateral_.size())
     servo_integral_.assign(lateral_.size(), 0.0);
