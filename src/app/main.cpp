@@ -55,27 +55,24 @@ int run_command(const std::string& scene_file, const std::string& out_dir, bool 
   return 0;
 }
 
+// A shape given on the command line as JSON text (genesis --shape / --cut).
+rocklab::ShapeSpec shape_option(const std::string& text, int dim, const std::string& option) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const std::exception& e) {
+    throw rocklab::InputError(option + ": not JSON: " + std::string(e.what()));
+  }
+  return rocklab::shape_from_json(j, dim, option, option.substr(2));
+}
+
 int genesis_command(const std::string& material_file, const std::string& out, bool quiet,
                     const std::string& shape, const std::string& cut, std::int64_t seed) {
   rocklab::MaterialCard card = rocklab::load_material_card(material_file);
-  if (!shape.empty()) {
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(shape);
-    } catch (const std::exception& e) {
-      throw rocklab::InputError("--shape: not JSON: " + std::string(e.what()));
-    }
-    card.vessel = rocklab::shape_from_json(j, card.dim, "--shape", "shape");
-  }
-  if (!cut.empty()) {
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(cut);
-    } catch (const std::exception& e) {
-      throw rocklab::InputError("--cut: not JSON: " + std::string(e.what()));
-    }
-    card.cut = rocklab::shape_from_json(j, card.dim, "--cut", "cut");
-  }
+  if (!shape.empty())
+    card.vessel = shape_option(shape, card.dim, "--shape");
+  if (!cut.empty())
+    card.cut = shape_option(cut, card.dim, "--cut");
   if (seed >= 0)
     card.seed = static_cast<std::uint64_t>(seed);
   const bool tty = !quiet && ::isatty(STDERR_FILENO);
