@@ -194,6 +194,7 @@ private:
   void finish(const std::string& why);
   double servo_velocity(std::size_t wall, double target, double area, double stress) const;
   double follow_velocity(std::size_t k) const;
+  void gather_wall_sums();
   double separation() const;
   double lateral_width(int d) const;
   double face_area(std::size_t k) const;
@@ -236,7 +237,10 @@ private:
   bool conf_seen_ = false;
   double conf_peak_min_ = 0, conf_peak_max_ = 0; ///< the band up to the peak
   std::vector<double> servo_integral_;           ///< sum of the confinement error of each wall [Pa]
-  std::int64_t bond_break_events_ = 0;           ///< bond_break events seen (each becomes a crack)
+  // per-step servo sums by wall index (derived each step, reused buffers)
+  std::vector<double> wall_k_, wall_f_, wall_fv_;
+  std::vector<int> lateral_of_wall_;
+  std::int64_t bond_break_events_ = 0; ///< bond_break events seen (each becomes a crack)
   double next_snapshot_strain_ = 0;
   bool snapshot_due_ = false, peak_snap_due_ = false;
   std::int64_t peak_snap_step_ = -1;
@@ -469,15 +473,52 @@ double Machine::current_area(double lateral_strain) const {
   return dim_ == 2 ? area0_ * f : area0_ * f * f;
 }
 
-double Machine::servo_velocity(std::size_t wall, double target, double area, double stress) const {
-  // Close the stress error in one step (kServoGain A / (sum k dt)), capped at 0.1 % of a mean
-  // grain radius per step. > 0 moves the wall into the specimen.
-  double ksum = 0;
+void Machine::gather_wall_sums() {
+  // One pass over the contacts per step for every servo-controlled wall: the stiffness sum of its
+  // contacts (servo gain) and, for confining walls, the force-weighted inward velocity of the
+  // grains touching it (feed-forward). Buffers are reused: nothing is allocated per step.
+  const std::size_t nw = m_.walls.size();
+  wall_k_.assign(nw, 0.0);
+  wall_f_.assign(nw, 0.0);
+  wall_fv_.assign(nw, 0.0);
+  lateral_of_wall_.assign(nw, -1);
+  for (std::size_t k = 0; k < lateral_.size(); ++k)
+    lateral_of_wall_[static_cast<std::size_t>(lateral_[k])] = static_cast<int>(k);
   const auto& cs = m_.contacts();
   const auto& os = m_.contact_outputs();
-  for (std::size_t ci = 0; ci < cs.size(); ++ci)
-    if (cs[ci].kind == ContactKind::BallFacet && static_cast<std::size_t>(cs[ci].end2) == wall)
-      ksum += os[ci].stiff.k_tran;
+  for (std::size_t ci = 0; ci < cs.size(); ++ci) {
+    if (cs[ci].kind != ContactKind::BallFacet)
+      continue;
+    const auto wall = static_cast<std::size_t>(cs[ci].end2);
+    wall_k_[wall] += os[ci].stiff.k_tran;
+    const int k = lateral_of_wall_[wall];
+    if (k < 0)
+      continue;
+    const double f = os[ci].force.norm();
+    if (f <= 0)
+      continue;
+    const Wall& w = m_.walls[wall];
+    const auto b = static_cast<std::size_t>(cs[ci].end1);
+    const Vec3& vel = m_.balls.vel[b];
+    const auto kk = static_cast<std::size_t>(k);
+    double inward;
+    if (lateral_axis_[kk] < 0) {
+      Vec3 r = m_.balls.pos[b] - w.center;
+      r -= r.dot(w.axis) * w.axis;
+      const double rn = r.norm();
+      inward = rn > 0 ? -vel.dot(r) / rn : 0.0;
+    } else {
+      inward = -lateral_sign_[kk] * vel[lateral_axis_[kk]];
+    }
+    wall_f_[wall] += f;
+    wall_fv_[wall] += f * inward;
+  }
+}
+
+double Machine::servo_velocity(std::size_t wall, double target, double area, double stress) const {
+  // Close the stress error in one step (kServoGain A / (sum k dt)), capped at 0.1 % of a mean
+  // grain radius per step. > 0 moves the wall into the specimen. Needs gather_wall_sums().
+  const double ksum = wall_k_[wall];
   const double dt = std::max(m_.timestep(), 1e-15);
   const double vmax = 1e-3 * r_avg_ / dt;
   const double v = ksum > 0 ? kServoGain * area / (ksum * dt) * (target - stress) : vmax;
@@ -486,33 +527,9 @@ double Machine::servo_velocity(std::size_t wall, double target, double area, dou
 
 double Machine::follow_velocity(std::size_t k) const {
   // Force-weighted mean velocity, towards the specimen (> 0 inwards), of the grains touching
-  // lateral wall k.
-  const auto wall = static_cast<std::int32_t>(lateral_[k]);
-  const Wall& w = m_.walls[static_cast<std::size_t>(wall)];
-  const auto& cs = m_.contacts();
-  const auto& os = m_.contact_outputs();
-  double fsum = 0, vsum = 0;
-  for (std::size_t ci = 0; ci < cs.size(); ++ci) {
-    if (cs[ci].kind != ContactKind::BallFacet || cs[ci].end2 != wall)
-      continue;
-    const double f = os[ci].force.norm();
-    if (f <= 0)
-      continue;
-    const auto b = static_cast<std::size_t>(cs[ci].end1);
-    const Vec3& vel = m_.balls.vel[b];
-    double inward;
-    if (lateral_axis_[k] < 0) {
-      Vec3 r = m_.balls.pos[b] - w.center;
-      r -= r.dot(w.axis) * w.axis;
-      const double rn = r.norm();
-      inward = rn > 0 ? -vel.dot(r) / rn : 0.0;
-    } else {
-      inward = -lateral_sign_[k] * vel[lateral_axis_[k]];
-    }
-    fsum += f;
-    vsum += f * inward;
-  }
-  return fsum > 0 ? vsum / fsum : 0.0;
+  // lateral wall k. Needs gather_wall_sums().
+  const auto wall = static_cast<std::size_t>(lateral_[k]);
+  return wall_f_[wall] > 0 ? wall_fv_[wall] / wall_f_[wall] : 0.0;
 }
 
 void Machine::measure(LabSample& s) const {
@@ -639,6 +656,8 @@ void Machine::control() {
   // dilating specimen is followed without a standing error), plus a proportional term that
   // closes the whole stress error in one step and a small integral trim (time constant 100 steps,
   // limited to 5 % of the confinement) against any remaining bias.
+  if (!lateral_.empty() || phase_ == kConfine || phase_ == kSeat)
+    gather_wall_sums();
   if (servo_integral_.size() != lateral_.size())
     servo_integral_.assign(lateral_.size(), 0.0);
   for (std::size_t k = 0; k < lateral_.size(); ++k) {
