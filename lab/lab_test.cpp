@@ -11,6 +11,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -245,6 +246,11 @@ private:
   bool snapshot_due_ = false, peak_snap_due_ = false;
   std::int64_t peak_snap_step_ = -1;
   std::string stop_reason_;
+  // Brazilian split check: which tenths of the loaded diameter hold a crack near it
+  std::array<bool, 10> split_bins_{};
+  std::size_t split_scanned_ = 0; ///< cracks already binned (rebuilt from the cracks on resume)
+  std::int64_t split_step_ = -1;  ///< first stop check (after the drop) that saw the split
+  bool split_seen();
   LabSample current_;
   std::vector<LabSample> samples_; ///< fine record of the loading (fits)
   std::vector<std::vector<double>> history_;
@@ -743,6 +749,33 @@ void Machine::finish(const std::string& why) {
     record_history();
 }
 
+bool Machine::split_seen() {
+  // Cracks within 0.2 D of the loaded diameter (the y axis through the centre), binned by their
+  // position along it; a split covers split_fraction of the ten bins without a gap.
+  const double d = width0_.y();
+  const auto& cracks = monitor_.cracks();
+  for (; split_scanned_ < cracks.size(); ++split_scanned_) {
+    const Crack& c = cracks[split_scanned_];
+    const Vec3 rel = c.position - center_;
+    if (std::abs(rel.x()) > 0.2 * d)
+      continue;
+    const double t = (rel.y() + 0.5 * d) / d;
+    const int bin = std::clamp(static_cast<int>(std::floor(t * 10.0)), 0, 9);
+    split_bins_[static_cast<std::size_t>(bin)] = true;
+  }
+  // The longest unbroken run of cracked tenths: crushing under both platens covers the two
+  // ends of the diameter but not the middle, a split covers it continuously.
+  int run = 0, longest = 0;
+  for (bool b : split_bins_) {
+    run = b ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  const bool split = longest >= static_cast<int>(std::ceil(p_.split_fraction * 10.0 - 1e-9));
+  if (split && split_step_ < 0)
+    split_step_ = m_.step();
+  return split;
+}
+
 void Machine::advance() {
   control();
   m_.cycle(1);
@@ -835,7 +868,20 @@ void Machine::advance() {
       finish("stop.max_steps reached");
     return;
   }
-  if (loading >= p_.min_steps && peak_ > load_ref_ && current_.load < p_.post_peak_fraction * peak_)
+  const bool dropped =
+      loading >= p_.min_steps && peak_ > load_ref_ && current_.load < p_.post_peak_fraction * peak_;
+  if (dropped && p_.type == TestType::Brazilian && p_.split_fraction > 0) {
+    // A disk can lose load locally (a grain crushed under a platen) and reload; only a split
+    // along the loaded diameter ends the test, or a load collapse below failed_fraction.
+    if (split_seen())
+      finish("the disk split and the load fell below " + format_double(p_.post_peak_fraction) +
+             " of its peak");
+    else if (current_.load < p_.failed_fraction * peak_)
+      finish("the load fell below " + format_double(p_.failed_fraction) +
+             " of its peak without a split along the loaded diameter");
+    else if (loading > p_.max_steps)
+      finish("stop.max_steps reached");
+  } else if (dropped)
     finish("the load fell below " + format_double(p_.post_peak_fraction) + " of its peak");
   else if (p_.strain_limit > 0 && current_.axial_strain >= p_.strain_limit)
     finish("stop.strain_limit reached");
@@ -884,6 +930,7 @@ nlohmann::json Machine::state() const {
   s["snapshot_due"] = snapshot_due_;
   s["peak_snap_step"] = peak_snap_step_;
   s["stop_reason"] = stop_reason_;
+  s["split_step"] = split_step_;
   nlohmann::json samples = nlohmann::json::array();
   for (const LabSample& x : samples_)
     samples.push_back({x.step, x.time, x.axial_strain, x.lateral_strain, x.axial_stress,
@@ -954,6 +1001,9 @@ void Machine::restore(const nlohmann::json& s) {
   snapshot_due_ = s["snapshot_due"];
   peak_snap_step_ = s["peak_snap_step"];
   stop_reason_ = s["stop_reason"];
+  split_step_ = s.value("split_step", std::int64_t{-1});
+  split_bins_.fill(false);
+  split_scanned_ = 0; // rebinned from the restored cracks at the next check
   samples_.clear();
   for (const auto& x : s["samples"])
     samples_.push_back({x[0].get<std::int64_t>(), x[1].get<double>(), x[2].get<double>(),
@@ -970,6 +1020,10 @@ nlohmann::json Machine::results() const {
   r["units"] = "SI (m, kg, s, N, Pa, J); stresses and strains compression positive";
   r["test"] = test_type_name(p_.type);
   r["stop_reason"] = stop_reason_;
+  if (p_.type == TestType::Brazilian && p_.split_fraction > 0)
+    r["split"] = {{"found", split_step_ >= 0},
+                  {"step", split_step_},
+                  {"fraction_required", p_.split_fraction}};
   const double crack_area = [&] {
     double a = 0;
     for (const Crack& c : monitor_.cracks())

@@ -1,6 +1,7 @@
 #include "lab/protocol.hpp"
 
 #include "io/json_input.hpp"
+#include "io/results.hpp"
 
 #include <filesystem>
 #include <fstream>
@@ -98,6 +99,14 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     p.post_peak_fraction = s.number("post_peak_fraction", {0, 1, true, true}, 0.9);
     p.min_steps = s.integer("min_steps", 0, std::numeric_limits<std::int64_t>::max(), 1000);
     p.strain_limit = s.number("strain_limit", Range::non_negative(), 0.0);
+    p.split_fraction = s.number("split_fraction", {0, 1, true, true}, 0.6);
+    p.failed_fraction = s.number("failed_fraction", {0, 1, true, false}, 0.3);
+    if (p.type != TestType::Brazilian && (s.has("split_fraction") || s.has("failed_fraction")))
+      s.fail(s.has("split_fraction") ? "split_fraction" : "failed_fraction",
+             "applies to Brazilian tests only");
+    if (p.failed_fraction >= p.post_peak_fraction)
+      s.fail("failed_fraction",
+             "must be below stop.post_peak_fraction (" + format_double(p.post_peak_fraction) + ")");
     p.max_steps = s.integer("max_steps", 1, std::numeric_limits<std::int64_t>::max(), 5'000'000);
     s.finish();
   }

@@ -41,6 +41,10 @@ struct Protocol {
   double post_peak_fraction = 0.9; ///< stop when the load falls to this fraction of its peak
   std::int64_t min_steps = 1000;   ///< ... but not before this many loading steps
   double strain_limit = 0;         ///< > 0: also stop at this axial strain [-]
+  /// Brazilian: the post-peak rule applies only once cracks near the loaded diameter cover this
+  /// fraction of it without a gap (a split, not crushing under the platens); 0: no check.
+  double split_fraction = 0.6;
+  double failed_fraction = 0.3; ///< Brazilian: stop without a split when the load falls this low
   std::int64_t max_steps = 5'000'000;
   // output
   std::int64_t history_every = 100; ///< a history row every this many steps

@@ -286,6 +286,11 @@ TEST(Lab, BrazilianAndDirectTension) {
                              1e-12));
   EXPECT_GT(b["cracks"]["tension"].get<int>(), 0);
   EXPECT_GT(b["tensile_strength_Pa"].get<double>(), 1e5);
+  // The disk ends split along its loaded diameter, not merely past its peak.
+  ASSERT_TRUE(b.contains("split")) << b.dump(1);
+  EXPECT_TRUE(b["split"]["found"].get<bool>()) << b["stop_reason"];
+  EXPECT_NE(b["stop_reason"].get<std::string>().find("split"), std::string::npos);
+  EXPECT_GE(b["split"]["step"].get<std::int64_t>(), b["peak_step"].get<std::int64_t>());
   const LabSummary dt = run("dt",
                             {{"test", "direct_tension"},
                              {"specimen", {{"file", specimen("lab_2d_fj")}}},

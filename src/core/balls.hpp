@@ -26,6 +26,12 @@ struct Balls {
   std::vector<std::uint8_t> fixity; ///< bit set of fixed DOFs (see Dof): velocity held constant
   std::vector<std::int32_t> group;  ///< index into the model's group-name table
   std::vector<std::int64_t> id;     ///< user id, unique
+  std::vector<std::int32_t> clump;  ///< clump index of a pebble, -1 for a free ball
+  // Accumulated energy of the ball's own motion [J], for group energy tracing (Eq. 2-3). A
+  // pebble's work is its clump's.
+  std::vector<double> body_work;    ///< gravity and applied loads
+  std::vector<double> gravity_work; ///< the gravity part
+  std::vector<double> damping_work; ///< dissipated by local damping
 
   std::size_t size() const { return pos.size(); }
 
@@ -64,6 +70,10 @@ struct Balls {
     fixity.push_back(0);
     group.push_back(group_index);
     id.push_back(user_id);
+    clump.push_back(-1);
+    body_work.push_back(0);
+    gravity_work.push_back(0);
+    damping_work.push_back(0);
     return pos.size() - 1;
   }
 };

@@ -16,11 +16,15 @@ struct EnergyLedger {
   double slip = 0;                  ///< dissipated by frictional slip (accumulated)
   double dashpot = 0;               ///< dissipated by dashpots (accumulated)
   double plastic = 0;               ///< dissipated by plastic contact deformation (accumulated)
-  double initial_total = 0;         ///< kinetic + stored energy at initialization
+  /// Bond strain energy released when bonds break (accumulated): the energy each bond_break
+  /// event reports. Exact for the parallel bond and tensile contact-bond breaks (all bond force
+  /// vanishes); an upper bound where the broken contact keeps carrying compression.
+  double bond_break = 0;
+  double initial_total = 0; ///< kinetic + stored energy at initialization
 
   double kinetic() const { return kinetic_translational + kinetic_rotational; }
   double stored() const { return strain + bond_strain; }
-  double dissipated() const { return local_damping + slip + dashpot + plastic; }
+  double dissipated() const { return local_damping + slip + dashpot + plastic + bond_break; }
   /// Energy in the system plus energy that left it, minus energy put in: zero when balanced.
   double balance_error() const {
     return kinetic() + stored() + dissipated() - (initial_total + body_work + boundary_work);

@@ -2,6 +2,8 @@
 
 #include "core/geometry.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -172,6 +174,7 @@ void Model::detect() {
       for (std::size_t i = 0; i < n; ++i) {
         const Vec3& xi = balls.pos[i];
         const double ri = balls.radius[i];
+        const std::int32_t clump_i = balls.clump[i];
         const std::size_t first = keys.size();
         const std::int64_t cx = cell_of(xi, 0), cy = cell_of(xi, 1);
         const std::int64_t cz = dim == 3 ? cell_of(xi, 2) : 0;
@@ -184,8 +187,8 @@ void Model::detect() {
               const std::size_t c = cell_index(x, y, z);
               for (std::int32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
                 const std::size_t j = static_cast<std::size_t>(cell_items_[k]);
-                if (j <= i)
-                  continue;
+                if (j <= i || (clump_i >= 0 && balls.clump[j] == clump_i))
+                  continue; // pebbles of one clump never touch
                 const double reach = ri + balls.radius[j] + margin_;
                 if ((balls.pos[j] - xi).squaredNorm() < reach * reach)
                   keys.push_back(contact_key(ContactKind::BallBall, static_cast<std::int32_t>(i),
@@ -354,6 +357,36 @@ void Model::retire_dissipation(const Contact& c) {
   ContactEnergy e = contact_energy(batches_, c.model, c.slot);
   e.strain = e.bond_strain = 0;
   retired_ += e;
+  share_contact_energy(c, e, group_retired_);
+}
+
+void Model::share_contact_energy(const Contact& c, const ContactEnergy& e,
+                                 std::vector<EnergyLedger>& out) const {
+  // Thesis section 3: a contact inside one group counts fully to it, a contact between two
+  // groups half to each; a wall is in no group.
+  auto add = [&](std::int32_t g, double f) {
+    const std::size_t k = static_cast<std::size_t>(g);
+    if (out.size() <= k)
+      out.resize(k + 1);
+    EnergyLedger& l = out[k];
+    l.strain += f * e.strain;
+    l.bond_strain += f * e.bond_strain;
+    l.slip += f * e.slip;
+    l.dashpot += f * e.dashpot;
+    l.plastic += f * e.plastic;
+  };
+  const std::int32_t g1 = balls.group[static_cast<std::size_t>(c.end1)];
+  if (c.kind == ContactKind::BallFacet) {
+    add(g1, 1.0);
+    return;
+  }
+  const std::int32_t g2 = balls.group[static_cast<std::size_t>(c.end2)];
+  if (g1 == g2) {
+    add(g1, 1.0);
+  } else {
+    add(g1, 0.5);
+    add(g2, 0.5);
+  }
 }
 
 void Model::force_displacement(double dt) {
@@ -459,6 +492,20 @@ void Model::force_displacement(double dt) {
             [](const Event& x, const Event& y) {
               return x.contact != y.contact ? x.contact < y.contact : x.seq < y.seq;
             });
+  for (std::size_t k = before; k < pending_events_.size(); ++k) {
+    const Event& ev = pending_events_[k];
+    if (ev.type != EventType::BondBreak || ev.energy == 0)
+      continue;
+    // The released bond energy leaves the stored partitions: book it, shared like the contact.
+    ledger_.bond_break += ev.energy;
+    Contact c;
+    c.end1 = static_cast<std::int32_t>(ev.contact >> 32);
+    c.kind = static_cast<ContactKind>((ev.contact >> 31) & 1u);
+    c.end2 = static_cast<std::int32_t>(ev.contact & 0x7fffffffu);
+    ContactEnergy released;
+    released.bond_strain = ev.energy;
+    share_contact_energy(c, released, broken_);
+  }
 
   // Sum contact forces into balls, each ball over its contacts in contact order.
   const std::size_t n = balls.size();
@@ -542,6 +589,154 @@ double Model::estimate_timestep() const {
   return dt;
 }
 
+void Model::move_clumps(double dt, std::array<double, 4>& sums) {
+  if (clumps.empty())
+    return;
+  const int dim = settings.dim;
+  const double alpha = settings.local_damping;
+  const Vec3 gvec = settings.gravity;
+  const int ntran = dim == 2 ? 2 : 3;
+  const auto s = block_sum<4>(clumps.size(), [&](std::size_t k, std::array<double, 4>& acc) {
+    Clump& c = clumps[k];
+    // Resultant about the centroid: pebble contact forces and moments, gravity on the union's
+    // mass, applied loads.
+    Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+    for (std::int32_t p : c.pebbles) {
+      const std::size_t i = static_cast<std::size_t>(p);
+      F += balls.force[i];
+      M += balls.moment[i] + (balls.pos[i] - c.pos).cross(balls.force[i]);
+    }
+    const Vec3 Fg = c.mass * gvec;
+    const Vec3 Fbody = Fg + c.applied_force;
+    F += Fbody;
+    M += c.applied_moment;
+    double bw = 0, gw = 0, dw = 0;
+    for (int d = 0; d < ntran; ++d) {
+      const double v0 = c.vel[d];
+      const double Fd = -alpha * std::abs(F[d]) * sign(v0);
+      const double v1 = v0 + (F[d] + Fd) / c.mass * dt;
+      c.vel[d] = v1;
+      dw -= Fd * 0.5 * (v0 + v1) * dt;
+      bw += Fbody[d] * 0.5 * (v0 + v1) * dt; // Eq. 2
+      gw += Fg[d] * 0.5 * (v0 + v1) * dt;    // Eq. 3
+    }
+    const Vec3 w0 = c.spin;
+    Vec3 Md = Vec3::Zero();
+    for (int d = (dim == 2 ? 2 : 0); d < 3; ++d)
+      Md[d] = -alpha * std::abs(M[d]) * sign(w0[d]);
+    c.L += (M + Md) * dt;
+    if (dim == 2)
+      c.L.x() = c.L.y() = 0;
+    Vec3 Lb = c.q.conjugate() * c.L;
+    free_rotation(c.q, Lb, c.inertia, dt, dim);
+    c.spin = c.q * Lb.cwiseQuotient(c.inertia);
+    const Vec3 wm = 0.5 * (w0 + c.spin);
+    dw -= Md.dot(wm) * dt;
+    bw += c.applied_moment.dot(wm) * dt;
+    c.pos += c.vel * dt;
+    for (std::size_t a = 0; a < c.pebbles.size(); ++a) {
+      const std::size_t i = static_cast<std::size_t>(c.pebbles[a]);
+      const Vec3 arm = c.q * c.offset[a];
+      const Vec3 x = c.pos + arm;
+      balls.disp[i] += x - balls.pos[i];
+      balls.pos[i] = x;
+      balls.vel[i] = c.vel + c.spin.cross(arm);
+      balls.spin[i] = c.spin;
+    }
+    c.body_work += bw;
+    c.gravity_work += gw;
+    c.local_damping += dw;
+    acc[0] += bw;
+    acc[1] += gw;
+    acc[3] += dw;
+  });
+  for (int k = 0; k < 4; ++k)
+    sums[static_cast<std::size_t>(k)] += s[static_cast<std::size_t>(k)];
+}
+
+std::size_t Model::add_clump(const std::vector<Pebble>& pebbles, double density, int group,
+                             std::int64_t id, std::int64_t first_pebble_id, const Vec3& velocity,
+                             const Vec3& spin) {
+  const int dim = settings.dim;
+  const MassProperties mp = union_mass_properties(pebbles, density, dim);
+  Clump c;
+  c.id = id;
+  c.group = group;
+  c.mass = mp.mass;
+  c.pos = mp.centroid;
+  c.vel = velocity;
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  if (dim == 3) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(mp.inertia);
+    R = es.eigenvectors();
+    if (R.determinant() < 0)
+      R.col(2) *= -1;
+    c.inertia = es.eigenvalues();
+  } else {
+    c.inertia = Vec3::Constant(mp.inertia(2, 2));
+  }
+  c.q = Eigen::Quaterniond(R);
+  c.q.normalize();
+  c.spin = dim == 2 ? Vec3(0, 0, spin.z()) : spin;
+  c.L = R * c.inertia.asDiagonal() * R.transpose() * c.spin;
+  double vsum = 0;
+  for (const Pebble& p : pebbles)
+    vsum += dim == 2 ? p.radius * p.radius : p.radius * p.radius * p.radius;
+  const std::int32_t index = static_cast<std::int32_t>(clumps.size());
+  for (std::size_t a = 0; a < pebbles.size(); ++a) {
+    const Pebble& p = pebbles[a];
+    const std::size_t i = balls.add(dim, first_pebble_id + static_cast<std::int64_t>(a), p.position,
+                                    p.radius, density, group);
+    // A pebble's own mass and inertia only enter the time-step estimate and dashpots: its
+    // share of the union by volume.
+    const double share = (dim == 2 ? p.radius * p.radius : p.radius * p.radius * p.radius) / vsum;
+    balls.mass[i] = c.mass * share;
+    balls.inertia[i] = (dim == 2 ? 0.5 : 0.4) * balls.mass[i] * p.radius * p.radius;
+    balls.clump[i] = index;
+    const Vec3 arm = p.position - c.pos;
+    balls.vel[i] = c.vel + c.spin.cross(arm);
+    balls.spin[i] = c.spin;
+    c.pebbles.push_back(static_cast<std::int32_t>(i));
+    c.offset.push_back(R.transpose() * arm);
+  }
+  clumps.push_back(std::move(c));
+  return static_cast<std::size_t>(index);
+}
+
+std::vector<EnergyLedger> Model::group_energy() const {
+  std::vector<EnergyLedger> out = group_retired_;
+  out.resize(std::max({out.size(), group_names.size(), broken_.size()}));
+  for (std::size_t g = 0; g < broken_.size(); ++g)
+    out[g].bond_break += broken_[g].bond_strain; // released bond energy (kept in bond_strain)
+  auto at = [&](std::int32_t g) -> EnergyLedger& {
+    const std::size_t k = static_cast<std::size_t>(g);
+    if (out.size() <= k)
+      out.resize(k + 1);
+    return out[k];
+  };
+  for (std::size_t i = 0; i < balls.size(); ++i) {
+    if (balls.clump[i] >= 0)
+      continue;
+    EnergyLedger& l = at(balls.group[i]);
+    l.kinetic_translational += 0.5 * balls.mass[i] * balls.vel[i].squaredNorm(); // Eq. 4
+    l.kinetic_rotational += 0.5 * balls.inertia[i] * balls.spin[i].squaredNorm();
+    l.body_work += balls.body_work[i];
+    l.gravity_work += balls.gravity_work[i];
+    l.local_damping += balls.damping_work[i];
+  }
+  for (const Clump& c : clumps) {
+    EnergyLedger& l = at(c.group);
+    l.kinetic_translational += c.kinetic_translational();
+    l.kinetic_rotational += c.kinetic_rotational();
+    l.body_work += c.body_work;
+    l.gravity_work += c.gravity_work;
+    l.local_damping += c.local_damping;
+  }
+  for (const Contact& c : contacts_)
+    share_contact_energy(c, contact_energy(batches_, c.model, c.slot), out); // Eq. 5-6, 10
+  return out;
+}
+
 void Model::law_of_motion(double dt) {
   const int dim = settings.dim;
   const double alpha = settings.local_damping;
@@ -551,8 +746,11 @@ void Model::law_of_motion(double dt) {
   // and 5 max displacement are handled with separate reductions below.
   double vmax = 0, dmax = 0, step_ratio = 0;
   bool bad = false;
-  const auto sums = block_sum<4>(balls.size(), [&](std::size_t i, std::array<double, 4>& acc) {
+  auto sums = block_sum<4>(balls.size(), [&](std::size_t i, std::array<double, 4>& acc) {
+    if (balls.clump[i] >= 0)
+      return; // pebbles move with their clump (move_clumps)
     const double m = balls.mass[i];
+    double bw = 0, gw = 0, dw = 0; // this ball's body, gravity and damping work
     const std::uint8_t fix = balls.fixity[i];
     const Vec3 Fg = m * gvec;
     const Vec3 Fbody = Fg + balls.applied_force[i];
@@ -566,11 +764,11 @@ void Model::law_of_motion(double dt) {
       } else {
         const double Fd = -alpha * std::abs(F[d]) * sign(v0);
         v1 = v0 + (F[d] + Fd) / m * dt;
-        acc[3] -= Fd * 0.5 * (v0 + v1) * dt;
+        dw -= Fd * 0.5 * (v0 + v1) * dt;
       }
       v[d] = v1;
-      acc[0] += Fbody[d] * 0.5 * (v0 + v1) * dt;
-      acc[1] += Fg[d] * 0.5 * (v0 + v1) * dt;
+      bw += Fbody[d] * 0.5 * (v0 + v1) * dt; // Eq. 2
+      gw += Fg[d] * 0.5 * (v0 + v1) * dt;    // Eq. 3
     }
     const double I = balls.inertia[i];
     const Vec3 M = balls.moment[i] + balls.applied_moment[i];
@@ -583,15 +781,22 @@ void Model::law_of_motion(double dt) {
       } else {
         const double Md = -alpha * std::abs(M[d]) * sign(w0);
         w1 = w0 + (M[d] + Md) / I * dt;
-        acc[3] -= Md * 0.5 * (w0 + w1) * dt;
+        dw -= Md * 0.5 * (w0 + w1) * dt;
       }
       w[d] = w1;
-      acc[0] += balls.applied_moment[i][d] * 0.5 * (w0 + w1) * dt;
+      bw += balls.applied_moment[i][d] * 0.5 * (w0 + w1) * dt;
     }
     const Vec3 dx = v * dt;
     balls.pos[i] += dx;
     balls.disp[i] += dx;
+    acc[0] += bw;
+    acc[1] += gw;
+    acc[3] += dw;
+    balls.body_work[i] += bw;
+    balls.gravity_work[i] += gw;
+    balls.damping_work[i] += dw;
   });
+  move_clumps(dt, sums);
   ledger_.body_work += sums[0];
   ledger_.gravity_work += sums[1];
   ledger_.boundary_work += sums[2];
@@ -662,11 +867,17 @@ void Model::cycle(std::int64_t count) {
 EnergyLedger Model::energy() const {
   EnergyLedger e = ledger_;
   const auto kin = block_sum<2>(balls.size(), [&](std::size_t i, std::array<double, 2>& acc) {
+    if (balls.clump[i] >= 0)
+      return; // counted with the clump
     acc[0] += 0.5 * balls.mass[i] * balls.vel[i].squaredNorm();
     acc[1] += 0.5 * balls.inertia[i] * balls.spin[i].squaredNorm();
   });
   e.kinetic_translational = kin[0];
   e.kinetic_rotational = kin[1];
+  for (const Clump& c : clumps) {
+    e.kinetic_translational += c.kinetic_translational();
+    e.kinetic_rotational += c.kinetic_rotational();
+  }
   const auto con = block_sum<5>(contacts_.size(), [&](std::size_t ci, std::array<double, 5>& acc) {
     const Contact& c = contacts_[ci];
     const ContactEnergy ce = contact_energy(batches_, c.model, c.slot);
@@ -687,6 +898,8 @@ EnergyLedger Model::energy() const {
 double Model::mean_unbalanced_force_ratio() const {
   const int ntran = settings.dim == 2 ? 2 : 3;
   const auto ub = block_sum<1>(balls.size(), [&](std::size_t i, std::array<double, 1>& acc) {
+    if (balls.clump[i] >= 0)
+      return;
     const Vec3 F = balls.force[i] + balls.mass[i] * settings.gravity + balls.applied_force[i];
     double s = 0;
     for (int d = 0; d < ntran; ++d)
@@ -701,7 +914,18 @@ double Model::mean_unbalanced_force_ratio() const {
       acc[1] += 1;
     }
   });
-  const double mean_ub = balls.size() ? ub[0] / static_cast<double>(balls.size()) : 0.0;
+  double ub_sum = ub[0];
+  std::size_t bodies = balls.size();
+  for (const Clump& c : clumps) {
+    Vec3 F = c.mass * settings.gravity + c.applied_force;
+    for (std::int32_t p : c.pebbles)
+      F += balls.force[static_cast<std::size_t>(p)];
+    if (settings.dim == 2)
+      F.z() = 0;
+    ub_sum += F.norm();
+    bodies -= c.pebbles.size() - 1;
+  }
+  const double mean_ub = bodies ? ub_sum / static_cast<double>(bodies) : 0.0;
   const double mean_cf = cf[1] > 0 ? cf[0] / cf[1] : 0.0;
   if (mean_cf <= 0)
     return mean_ub > 0 ? std::numeric_limits<double>::infinity() : 0.0;
@@ -903,6 +1127,22 @@ void Model::remove_balls(const std::vector<bool>& remove) {
   for (std::size_t i = 0; i < n; ++i)
     if (!remove[i])
       map[i] = static_cast<std::int32_t>(kept++);
+  for (const Clump& c : clumps) {
+    std::size_t gone = 0;
+    for (std::int32_t p : c.pebbles)
+      gone += remove[static_cast<std::size_t>(p)] ? 1 : 0;
+    if (gone != 0 && gone != c.pebbles.size())
+      throw std::invalid_argument("cannot remove part of clump " + std::to_string(c.id));
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    if (remove[i] && balls.clump[i] < 0) {
+      const std::size_t g = static_cast<std::size_t>(balls.group[i]);
+      if (group_retired_.size() <= g)
+        group_retired_.resize(g + 1);
+      group_retired_[g].body_work += balls.body_work[i];
+      group_retired_[g].gravity_work += balls.gravity_work[i];
+      group_retired_[g].local_damping += balls.damping_work[i];
+    }
   auto compact = [&](auto& v) {
     std::size_t j = 0;
     for (std::size_t i = 0; i < n; ++i)
@@ -914,6 +1154,28 @@ void Model::remove_balls(const std::vector<bool>& remove) {
   compact(balls.moment), compact(balls.applied_force), compact(balls.applied_moment);
   compact(balls.disp), compact(balls.radius), compact(balls.mass), compact(balls.inertia);
   compact(balls.density), compact(balls.fixity), compact(balls.group), compact(balls.id);
+  compact(balls.clump), compact(balls.body_work), compact(balls.gravity_work);
+  compact(balls.damping_work);
+  // Clumps go whole or stay whole; the work of what goes stays in the group totals.
+  std::vector<Clump> kept_clumps;
+  for (Clump& c : clumps) {
+    if (remove[static_cast<std::size_t>(c.pebbles.front())]) {
+      const std::size_t g = static_cast<std::size_t>(c.group);
+      if (group_retired_.size() <= g)
+        group_retired_.resize(g + 1);
+      group_retired_[g].body_work += c.body_work;
+      group_retired_[g].gravity_work += c.gravity_work;
+      group_retired_[g].local_damping += c.local_damping;
+      continue;
+    }
+    for (std::int32_t& p : c.pebbles)
+      p = map[static_cast<std::size_t>(p)];
+    kept_clumps.push_back(std::move(c));
+  }
+  clumps = std::move(kept_clumps);
+  for (std::size_t k = 0; k < clumps.size(); ++k)
+    for (std::int32_t p : clumps[k].pebbles)
+      balls.clump[static_cast<std::size_t>(p)] = static_cast<std::int32_t>(k);
   // Contacts of removed balls go; the others keep their order (the index map is monotonic).
   compact_contacts([&](Contact& c) {
     const bool bb = c.kind == ContactKind::BallBall;

@@ -4,6 +4,7 @@
 
 #include "contact/registry.hpp"
 #include "core/balls.hpp"
+#include "core/clumps.hpp"
 #include "core/contact.hpp"
 #include "core/energy.hpp"
 #include "core/events.hpp"
@@ -50,6 +51,7 @@ class Model {
 public:
   ModelSettings settings;
   Balls balls;
+  std::vector<Clump> clumps; ///< rigid bodies; their pebbles are balls with balls.clump >= 0
   std::vector<Wall> walls;
   std::vector<std::string> group_names;
   std::vector<ModelRule> rules;
@@ -57,6 +59,21 @@ public:
 
   /// Index of a group name, added if new.
   int group_index(const std::string& name);
+
+  /// Add a clump of pebbles (global positions) at uniform density; mass, centroid and
+  /// principal inertia from the pebble union (clumps.hpp). Pebbles get ids first_pebble_id,
+  /// first_pebble_id + 1, ... and the clump's group. Returns the clump index. Call before
+  /// initialize().
+  std::size_t add_clump(const std::vector<Pebble>& pebbles, double density, int group,
+                        std::int64_t id, std::int64_t first_pebble_id, const Vec3& velocity,
+                        const Vec3& spin);
+  /// Energy per group (index = group index), the thesis' sharing rule (section 3): a ball's or
+  /// clump's kinetic energy and body work go to its group; a contact's stored and dissipated
+  /// energies go fully to the group when both pieces are in it, half to each group otherwise
+  /// (a wall belongs to no group: ball-facet contacts count fully to the ball's group).
+  /// boundary_work and initial_total are model-wide and left at zero here. Summed over the
+  /// groups, every other partition equals energy() to round-off.
+  std::vector<EnergyLedger> group_energy() const;
 
   /// Detect contacts and compute the initial forces; call once after set-up.
   void initialize();
@@ -112,6 +129,10 @@ private:
   void ensure_thread_buffers();
   void rebuild_adjacency();
   void retire_dissipation(const Contact& c);
+  void move_clumps(double dt, std::array<double, 4>& sums);
+  /// Add `share` of a contact's energies to the group ledgers (sharing rule).
+  void share_contact_energy(const Contact& c, const ContactEnergy& e,
+                            std::vector<EnergyLedger>& out) const;
   void compact_contacts(const std::function<bool(Contact&)>& keep);
   void detect();
   void force_displacement(double dt_increment);
@@ -145,6 +166,10 @@ private:
   bool initialized_ = false;
   EnergyLedger ledger_;
   ContactEnergy retired_; ///< dissipation of deleted contacts
+  /// Per group: dissipation of deleted contacts and work of removed balls (group tracing).
+  std::vector<EnergyLedger> group_retired_;
+  /// Per group: bond energy released by breaks (in the bond_strain field, see group_energy).
+  std::vector<EnergyLedger> broken_;
   std::size_t blowup_contact_ = 0;
 };
 

@@ -231,11 +231,17 @@ std::string history_header(const std::vector<HistoryColumn>& cols) {
 std::string history_row(const Model& m, const std::vector<HistoryColumn>& cols,
                         const EventCounts& counts) {
   const EnergyLedger e = m.energy();
+  std::vector<EnergyLedger> groups;
+  for (const HistoryColumn& c : cols)
+    if (c.kind == HistoryColumn::Kind::GroupEnergy) {
+      groups = m.group_energy();
+      break;
+    }
   std::string s;
   for (std::size_t k = 0; k < cols.size(); ++k) {
     if (k)
       s += ',';
-    s += format_double(history_value(m, cols[k], e, counts));
+    s += format_double(history_value(m, cols[k], e, counts, groups));
   }
   s += '\n';
   return s;

@@ -184,6 +184,71 @@ void read_walls(JsonObject& top, Model& m) {
   }
 }
 
+// Clumps: explicit pebbles (global positions) or a template placed by the centroid of its
+// pebble centres, scaled by a pebble radius and turned (2D: degrees about z; 3D: a rotation
+// vector in degrees). Pebble ids continue after the largest ball id.
+void read_clumps(JsonObject& top, Model& m, std::map<std::int64_t, std::string>& ids) {
+  const int dim = m.settings.dim;
+  std::int64_t next_id = 1;
+  for (const auto& [id, where] : ids)
+    next_id = std::max(next_id, id + 1);
+  std::map<std::int64_t, std::string> clump_ids;
+  for (const auto& [jc, path] : top.array("clumps", false)) {
+    JsonObject o(*jc, top.file(), path);
+    const std::int64_t id = o.integer("id", 0, std::numeric_limits<std::int32_t>::max(),
+                                      static_cast<std::int64_t>(m.clumps.size()) + 1);
+    if (auto [it, fresh] = clump_ids.emplace(id, path); !fresh)
+      o.fail("id", std::to_string(id) + " is already used by " + it->second);
+    const double rho = o.number("density", Range::positive(), std::nullopt, "kg/m^3");
+    const int g = m.group_index(o.string("group", "default"));
+    std::vector<Pebble> pebbles;
+    if (o.has("pebbles") == o.has("template"))
+      o.fail(o.has("pebbles") ? "template" : "pebbles",
+             "give either 'pebbles' (a list) or 'template' (a name), exactly one");
+    if (o.has("pebbles")) {
+      for (const auto& [jp, ppath] : o.array("pebbles")) {
+        JsonObject po(*jp, top.file(), ppath);
+        pebbles.push_back(
+            {po.vec("position", dim), po.number("radius", Range::positive(), std::nullopt, "m")});
+        po.finish();
+      }
+      if (pebbles.empty())
+        o.fail("pebbles", "give at least one pebble");
+    } else {
+      const std::string name =
+          o.choice("template", {"single", "pair", "line3", "triangle3", "tetra4"});
+      if (dim == 2 && name == "tetra4")
+        o.fail("template", "\"tetra4\" is a 3D template");
+      const double r = o.number("radius", Range::positive(), std::nullopt, "m");
+      const Vec3 at = o.vec("position", dim);
+      Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+      constexpr double deg = 3.14159265358979323846 / 180.0;
+      if (dim == 2) {
+        R = Eigen::AngleAxisd(o.number("rotation", Range::any(), 0.0, "deg") * deg, Vec3::UnitZ())
+                .toRotationMatrix();
+      } else {
+        const Vec3 phi = o.vec("rotation", dim, Vec3::Zero()) * deg;
+        if (phi.norm() > 0)
+          R = Eigen::AngleAxisd(phi.norm(), phi.normalized()).toRotationMatrix();
+      }
+      for (const Pebble& p : clump_template(name, dim))
+        pebbles.push_back({at + R * (p.position * r), r});
+    }
+    const Vec3 vel = o.vec("velocity", dim, Vec3::Zero());
+    const Vec3 spin = dim == 2 ? Vec3(0, 0, o.number("spin", Range::any(), 0.0, "rad/s"))
+                               : o.vec("spin", dim, Vec3::Zero());
+    for (std::size_t k = 0; k < pebbles.size(); ++k)
+      ids.emplace(next_id + static_cast<std::int64_t>(k), path + ".pebbles");
+    const std::size_t index = m.add_clump(pebbles, rho, g, id, next_id, vel, spin);
+    next_id += static_cast<std::int64_t>(pebbles.size());
+    Clump& c = m.clumps[index];
+    c.applied_force = o.vec("force", dim, Vec3::Zero());
+    c.applied_moment = dim == 2 ? Vec3(0, 0, o.number("moment", Range::any(), 0.0, "N m"))
+                                : o.vec("moment", dim, Vec3::Zero());
+    o.finish();
+  }
+}
+
 void read_balls(JsonObject& top, Model& m) {
   const int dim = m.settings.dim;
   std::map<std::int64_t, std::string> ids;
@@ -277,8 +342,10 @@ void read_balls(JsonObject& top, Model& m) {
                        " balls without overlap in " + std::to_string(attempts) +
                        " attempts; enlarge the box or lower the count");
   }
+  read_clumps(top, m, ids);
   if (m.balls.size() == 0)
-    throw InputError(top.file() + ": the scene has no balls (give 'balls' or 'generate')");
+    throw InputError(top.file() +
+                     ": the scene has no balls (give 'balls', 'generate' or 'clumps')");
 }
 
 LinearProps read_linear_props(JsonObject& p, bool kn_required) {
@@ -514,6 +581,7 @@ void read_history(JsonObject& top, Scene& s) {
                                                  "slip",
                                                  "dashpot",
                                                  "plastic",
+                                                 "bond_break",
                                                  "balance_error"};
   for (const auto& [jc, path] : h.array("columns")) {
     if (!jc->is_string())
@@ -600,10 +668,45 @@ void read_history(JsonObject& top, Scene& s) {
       if (c.quantity != "force" && c.quantity != "moment" && c.quantity != "center")
         bad("has quantity \"" + c.quantity + "\" (allowed: force, moment, center)");
       c.component = component(parts[3]);
+    } else if (parts[0] == "group" && parts.size() == 3) {
+      c.kind = HistoryColumn::Kind::GroupEnergy;
+      auto it = std::find(m.group_names.begin(), m.group_names.end(), parts[1]);
+      if (it == m.group_names.end())
+        bad("names group \"" + parts[1] + "\", which no ball or clump has");
+      c.index = static_cast<std::size_t>(it - m.group_names.begin());
+      c.quantity = parts[2];
+      if (std::find(energies.begin(), energies.end(), c.quantity) == energies.end() ||
+          c.quantity == "boundary_work" || c.quantity == "balance_error")
+        bad("names an energy partition that is not traced per group (allowed: kinetic, "
+            "kinetic_translational, kinetic_rotational, strain, bond_strain, body_work, "
+            "gravity_work, local_damping, slip, dashpot, plastic, bond_break)");
+    } else if (parts[0] == "clump" && parts.size() == 4) {
+      c.kind = HistoryColumn::Kind::Clump;
+      std::int64_t id = -1;
+      try {
+        std::size_t used = 0;
+        id = std::stoll(parts[1], &used);
+        if (used != parts[1].size())
+          throw std::invalid_argument("id");
+      } catch (const std::exception&) {
+        bad("has a clump id that is not an integer");
+      }
+      auto it = std::find_if(m.clumps.begin(), m.clumps.end(),
+                             [&](const Clump& k) { return k.id == id; });
+      if (it == m.clumps.end())
+        bad("names clump id " + parts[1] + ", which does not exist");
+      c.index = static_cast<std::size_t>(it - m.clumps.begin());
+      c.quantity = parts[2];
+      if (c.quantity != "position" && c.quantity != "velocity" && c.quantity != "spin" &&
+          c.quantity != "angular_momentum")
+        bad("has quantity \"" + c.quantity +
+            "\" (allowed: position, velocity, spin, angular_momentum)");
+      c.component = component(parts[3]);
     } else {
       bad("is not known (see docs/scene-format.md: step, time, timestep, contacts, "
           "active_contacts, unbalanced_force_ratio, energy/NAME, events/NAME, "
-          "ball/ID/QUANTITY/COMPONENT, wall/NAME/QUANTITY/COMPONENT)");
+          "ball/ID/QUANTITY/COMPONENT, wall/NAME/QUANTITY/COMPONENT, group/NAME/PARTITION, "
+          "clump/ID/QUANTITY/COMPONENT)");
     }
     s.history.push_back(c);
   }
@@ -753,8 +856,26 @@ void EventCounts::add(const std::vector<Event>& events) {
   }
 }
 
+double energy_partition(const EnergyLedger& e, const std::string& name) {
+  const std::map<std::string, double> v{{"kinetic", e.kinetic()},
+                                        {"kinetic_translational", e.kinetic_translational},
+                                        {"kinetic_rotational", e.kinetic_rotational},
+                                        {"strain", e.strain},
+                                        {"bond_strain", e.bond_strain},
+                                        {"body_work", e.body_work},
+                                        {"gravity_work", e.gravity_work},
+                                        {"boundary_work", e.boundary_work},
+                                        {"local_damping", e.local_damping},
+                                        {"slip", e.slip},
+                                        {"dashpot", e.dashpot},
+                                        {"plastic", e.plastic},
+                                        {"bond_break", e.bond_break},
+                                        {"balance_error", e.balance_error()}};
+  return v.at(name);
+}
+
 double history_value(const Model& m, const HistoryColumn& c, const EnergyLedger& e,
-                     const EventCounts& counts) {
+                     const EventCounts& counts, const std::vector<EnergyLedger>& groups) {
   auto comp = [&](const Vec3& v) { return c.component == 3 ? v.norm() : v[c.component]; };
   switch (c.kind) {
   case HistoryColumn::Kind::Step:
@@ -777,21 +898,19 @@ double history_value(const Model& m, const HistoryColumn& c, const EnergyLedger&
     if (c.quantity == "slip_change")
       return static_cast<double>(counts.slip_change);
     return static_cast<double>(counts.bond_break);
-  case HistoryColumn::Kind::Energy: {
-    const std::map<std::string, double> v{{"kinetic", e.kinetic()},
-                                          {"kinetic_translational", e.kinetic_translational},
-                                          {"kinetic_rotational", e.kinetic_rotational},
-                                          {"strain", e.strain},
-                                          {"bond_strain", e.bond_strain},
-                                          {"body_work", e.body_work},
-                                          {"gravity_work", e.gravity_work},
-                                          {"boundary_work", e.boundary_work},
-                                          {"local_damping", e.local_damping},
-                                          {"slip", e.slip},
-                                          {"dashpot", e.dashpot},
-                                          {"plastic", e.plastic},
-                                          {"balance_error", e.balance_error()}};
-    return v.at(c.quantity);
+  case HistoryColumn::Kind::Energy:
+    return energy_partition(e, c.quantity);
+  case HistoryColumn::Kind::GroupEnergy:
+    return c.index < groups.size() ? energy_partition(groups[c.index], c.quantity) : 0.0;
+  case HistoryColumn::Kind::Clump: {
+    const Clump& k = m.clumps[c.index];
+    if (c.quantity == "position")
+      return comp(k.pos);
+    if (c.quantity == "velocity")
+      return comp(k.vel);
+    if (c.quantity == "spin")
+      return comp(k.spin);
+    return comp(k.L);
   }
   case HistoryColumn::Kind::Ball: {
     const std::size_t i = c.index;

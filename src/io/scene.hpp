@@ -33,7 +33,9 @@ struct HistoryColumn {
     Contacts,
     ActiveContacts,
     Ratio,
-    Events
+    Events,
+    Clump,      ///< clump/ID/QUANTITY/COMPONENT
+    GroupEnergy ///< group/NAME/PARTITION (thesis section 3 sharing rule)
   };
   Kind kind = Kind::Step;
   std::string quantity;  ///< energy partition, ball/wall quantity or event type
@@ -84,7 +86,10 @@ struct EventCounts {
 };
 
 /// Value of one history column in the current state.
+/// `groups` is Model::group_energy(), needed only by group columns (may be empty otherwise).
 double history_value(const Model& m, const HistoryColumn& c, const EnergyLedger& e,
-                     const EventCounts& counts);
+                     const EventCounts& counts, const std::vector<EnergyLedger>& groups);
+/// One energy partition by name (energy/NAME columns); throws std::out_of_range if unknown.
+double energy_partition(const EnergyLedger& e, const std::string& name);
 
 } // namespace rocklab

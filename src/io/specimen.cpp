@@ -213,7 +213,7 @@ template <class A> void io(A& a, SurfaceProps& p) {
 template <class A> void io(A& a, EnergyLedger& e) {
   a(e.kinetic_translational), a(e.kinetic_rotational), a(e.strain), a(e.bond_strain),
       a(e.body_work), a(e.gravity_work), a(e.boundary_work), a(e.local_damping), a(e.slip),
-      a(e.dashpot), a(e.plastic), a(e.initial_total);
+      a(e.dashpot), a(e.plastic), a(e.bond_break), a(e.initial_total);
 }
 template <class A> void io(A& a, ContactEnergy& e) {
   a(e.strain), a(e.bond_strain), a(e.slip), a(e.dashpot), a(e.plastic);
@@ -237,10 +237,21 @@ template <class A> void Model::serialize(A& a) {
       each(a, balls.moment), each(a, balls.applied_force), each(a, balls.applied_moment),
       each(a, balls.disp), each(a, balls.radius), each(a, balls.mass), each(a, balls.inertia),
       each(a, balls.density), each(a, balls.fixity), each(a, balls.group), each(a, balls.id);
+  each(a, balls.clump), each(a, balls.body_work), each(a, balls.gravity_work),
+      each(a, balls.damping_work);
+  a.vec(clumps, [&](Clump& c) {
+    a(c.id), a(c.group);
+    each(a, c.pebbles), each(a, c.offset);
+    a(c.mass), a(c.inertia), a(c.pos), a(c.vel), a(c.L), a(c.spin), a(c.q.w()), a(c.q.x()),
+        a(c.q.y()), a(c.q.z()), a(c.applied_force), a(c.applied_moment), a(c.body_work),
+        a(c.gravity_work), a(c.local_damping);
+  });
   const std::size_t n = balls.size();
-  for (std::size_t len : {balls.vel.size(), balls.spin.size(), balls.force.size(),
-                          balls.radius.size(), balls.mass.size(), balls.fixity.size(),
-                          balls.group.size(), balls.id.size(), balls.disp.size()})
+  for (std::size_t len :
+       {balls.vel.size(), balls.spin.size(), balls.force.size(), balls.radius.size(),
+        balls.mass.size(), balls.fixity.size(), balls.group.size(), balls.id.size(),
+        balls.disp.size(), balls.clump.size(), balls.body_work.size(), balls.damping_work.size(),
+        balls.gravity_work.size()})
     if (len != n)
       throw InputError("corrupt specimen body (ball arrays of different lengths)");
   a.vec(walls, [&](Wall& w) { io(a, w); });
@@ -254,6 +265,7 @@ template <class A> void Model::serialize(A& a) {
       a(step_), a(initialized_);
   io(a, ledger_);
   io(a, retired_);
+  each(a, group_retired_), each(a, broken_);
   if constexpr (A::reading) {
     if (outputs_.size() != contacts_.size())
       throw InputError("corrupt specimen body (contact arrays of different lengths)");
@@ -262,6 +274,11 @@ template <class A> void Model::serialize(A& a) {
           (c.kind == ContactKind::BallBall &&
            (c.end2 < 0 || static_cast<std::size_t>(c.end2) >= n)))
         throw InputError("corrupt specimen body (contact end out of range)");
+    for (std::size_t k = 0; k < clumps.size(); ++k)
+      for (std::int32_t p : clumps[k].pebbles)
+        if (p < 0 || static_cast<std::size_t>(p) >= n ||
+            balls.clump[static_cast<std::size_t>(p)] != static_cast<std::int32_t>(k))
+          throw InputError("corrupt specimen body (clump pebble out of range)");
     rebuild_adjacency(); // derived data, exactly as detection builds it
   }
 }

@@ -14,7 +14,7 @@
 
 namespace rocklab {
 
-inline constexpr int kSpecimenVersion = 4;
+inline constexpr int kSpecimenVersion = 5;
 
 /// Write atomically (temporary file, then rename). Throws std::runtime_error naming the file.
 void save_model(const Model& m, const std::string& path, const nlohmann::json& meta = {});
