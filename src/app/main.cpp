@@ -3,6 +3,7 @@
 #include "io/scene.hpp"
 #include "io/scene_run.hpp"
 #include "io/specimen.hpp"
+#include "lab/drop_test.hpp"
 #include "lab/lab_test.hpp"
 #include "lab/suite.hpp"
 #include "materials/genesis.hpp"
@@ -178,8 +179,46 @@ void print_lab_results(const rocklab::LabSummary& s, const std::string& out_dir)
   }
 }
 
+void print_drop_results(const nlohmann::json& r, const std::string& out_dir) {
+  std::printf("drop test   rock %.4g kg%s, contact %s (units SI)\n",
+              r["rock"]["mass_kg"].get<double>(),
+              r["rock"]["dimension"].get<int>() == 2 ? " per m thickness" : "",
+              r["contact_model"].get<std::string>().c_str());
+  std::printf("%8s %10s %10s %8s %8s %10s %10s %8s\n", "v [m/s]", "v_in", "v_out_n", "e_v", "e_E",
+              "spin", "plastic[J]", "b");
+  for (const auto& d : r["drops"])
+    std::printf("%8.3g %10.4g %10.4g %8.4f %8.4f %10.4g %10.4g %8.4g\n",
+                d["impact_speed_m_s"].get<double>(), d["measured_impact_speed_m_s"].get<double>(),
+                d["rebound_normal_velocity_m_s"].get<double>(),
+                d["restitution_velocity"].get<double>(), d["restitution_energy"].get<double>(),
+                d["rebound_spin_rad_s"].get<double>(), d["lost_J"]["plastic"].get<double>(),
+                d.value("exponent", 0.0));
+  if (r.contains("calibration"))
+    std::printf("calibration  Eq. 35 bounce velocity matched within %.3g %%\n",
+                100 * r["calibration"]["worst_bounce_velocity_error"].get<double>());
+  std::printf("results      %s/results.json  %s/restitution.csv  %s/history.csv\n", out_dir.c_str(),
+              out_dir.c_str(), out_dir.c_str());
+  for (const auto& f : r["files"])
+    if (f.get<std::string>().ends_with(".svg"))
+      std::printf("plot         %s/%s\n", out_dir.c_str(), f.get<std::string>().c_str());
+}
+
 int test_command(const std::string& protocol_file, const std::string& out_dir, bool quiet,
                  std::int64_t checkpoint_every, const std::string& resume) {
+  {
+    const nlohmann::json j = rocklab::read_json_file(protocol_file);
+    if (j.is_object() && j.value("test", std::string()) == "drop") {
+      if (checkpoint_every > 0 || !resume.empty())
+        throw rocklab::InputError(protocol_file +
+                                  ": drop tests are short and have no checkpoints; leave out "
+                                  "--checkpoint-every and --resume");
+      const rocklab::DropProtocol p = rocklab::drop_protocol_from_json(j, protocol_file);
+      const nlohmann::json r = rocklab::run_drop_test(p, out_dir, !quiet, &g_interrupt);
+      if (!quiet)
+        print_drop_results(r, out_dir);
+      return 0;
+    }
+  }
   const rocklab::Protocol p = rocklab::load_protocol(protocol_file);
   rocklab::LabOptions o;
   o.out_dir = out_dir;
@@ -263,8 +302,9 @@ int main(int argc, char** argv) {
   std::string protocol_file, test_out, resume;
   std::int64_t checkpoint_every = 0;
   CLI::App* test = app.add_subcommand(
-      "test", "Run a laboratory test (docs/protocol-format.md): UCS, triaxial, Brazilian or direct "
-              "tension; writes OUT/results.json, history.csv, cracks.csv, vtk/ and plots");
+      "test",
+      "Run a laboratory test (docs/protocol-format.md): UCS, triaxial, Brazilian, direct "
+      "tension or drop (impact); writes OUT/results.json, history.csv, cracks.csv, vtk/ and plots");
   test->add_option("protocol", protocol_file, "Protocol file (JSON)")->required();
   test->add_option("-o,--out", test_out, "Output directory")->required();
   test->add_option("--checkpoint-every", checkpoint_every,

@@ -111,11 +111,6 @@ MassProperties union_mass_properties(const std::vector<Pebble>& pebbles, double 
   return mp;
 }
 
-const std::vector<std::string>& clump_template_names() {
-  static const std::vector<std::string> names{"single", "pair", "line3", "triangle3", "tetra4"};
-  return names;
-}
-
 std::vector<Pebble> clump_template(const std::string& name, int dim) {
   std::vector<Vec3> c;
   if (name == "single") {

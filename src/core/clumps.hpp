@@ -46,8 +46,6 @@ MassProperties union_mass_properties(const std::vector<Pebble>& pebbles, double 
 /// (three mutually touching, the thesis' three-pebble rock), "tetra4" (3D: four mutually
 /// touching). Throws std::invalid_argument for an unknown name.
 std::vector<Pebble> clump_template(const std::string& name, int dim);
-/// The template names, for error messages.
-const std::vector<std::string>& clump_template_names();
 
 struct Clump {
   std::int64_t id = 0;

@@ -201,39 +201,7 @@ void read_clumps(JsonObject& top, Model& m, std::map<std::int64_t, std::string>&
       o.fail("id", std::to_string(id) + " is already used by " + it->second);
     const double rho = o.number("density", Range::positive(), std::nullopt, "kg/m^3");
     const int g = m.group_index(o.string("group", "default"));
-    std::vector<Pebble> pebbles;
-    if (o.has("pebbles") == o.has("template"))
-      o.fail(o.has("pebbles") ? "template" : "pebbles",
-             "give either 'pebbles' (a list) or 'template' (a name), exactly one");
-    if (o.has("pebbles")) {
-      for (const auto& [jp, ppath] : o.array("pebbles")) {
-        JsonObject po(*jp, top.file(), ppath);
-        pebbles.push_back(
-            {po.vec("position", dim), po.number("radius", Range::positive(), std::nullopt, "m")});
-        po.finish();
-      }
-      if (pebbles.empty())
-        o.fail("pebbles", "give at least one pebble");
-    } else {
-      const std::string name =
-          o.choice("template", {"single", "pair", "line3", "triangle3", "tetra4"});
-      if (dim == 2 && name == "tetra4")
-        o.fail("template", "\"tetra4\" is a 3D template");
-      const double r = o.number("radius", Range::positive(), std::nullopt, "m");
-      const Vec3 at = o.vec("position", dim);
-      Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-      constexpr double deg = 3.14159265358979323846 / 180.0;
-      if (dim == 2) {
-        R = Eigen::AngleAxisd(o.number("rotation", Range::any(), 0.0, "deg") * deg, Vec3::UnitZ())
-                .toRotationMatrix();
-      } else {
-        const Vec3 phi = o.vec("rotation", dim, Vec3::Zero()) * deg;
-        if (phi.norm() > 0)
-          R = Eigen::AngleAxisd(phi.norm(), phi.normalized()).toRotationMatrix();
-      }
-      for (const Pebble& p : clump_template(name, dim))
-        pebbles.push_back({at + R * (p.position * r), r});
-    }
+    const std::vector<Pebble> pebbles = read_clump_pebbles(o, dim, true);
     const Vec3 vel = o.vec("velocity", dim, Vec3::Zero());
     const Vec3 spin = dim == 2 ? Vec3(0, 0, o.number("spin", Range::any(), 0.0, "rad/s"))
                                : o.vec("spin", dim, Vec3::Zero());
@@ -547,12 +515,13 @@ void read_contact_models(JsonObject& top, Model& m) {
         o.fail("wall", "no wall is named \"" + wname + "\"");
       rule.wall = found;
     }
-    const std::string model = o.choice("model", {"linear", "linearpbond", "flatjoint",
-                                                 "smoothjoint", "hysteretic", "powerplastic"});
+    const std::string model =
+        o.choice("model", {"linear", "linearpbond", "flatjoint", "smoothjoint", "hysteretic",
+                           "powerplastic", "contactbond"});
     if (model == "smoothjoint" && rule.ball_facet)
       o.fail("model", "the smooth-joint model is installed at ball-ball contacts only");
     JsonObject props = o.object("properties");
-    if (model != "flatjoint" && model != "hysteretic" && model != "powerplastic") {
+    if (model == "linear" || model == "linearpbond" || model == "smoothjoint") {
       rule.inherit = props.boolean("inherit", false);
       if (rule.inherit && rule.ball_facet)
         props.fail("inherit", "walls hold no surface properties; inherit on ball-ball rules only");
@@ -714,6 +683,48 @@ void read_history(JsonObject& top, Scene& s) {
 }
 
 } // namespace
+
+std::vector<Pebble> read_clump_pebbles(JsonObject& o, int dim, bool position_required) {
+  std::vector<Pebble> pebbles;
+  if (o.has("pebbles") == o.has("template"))
+    o.fail(o.has("pebbles") ? "template" : "pebbles",
+           "give either 'pebbles' (a list) or 'template' (a name), exactly one");
+  if (o.has("pebbles")) {
+    for (const auto& [jp, ppath] : o.array("pebbles")) {
+      JsonObject po(*jp, o.file(), ppath);
+      pebbles.push_back(
+          {po.vec("position", dim), po.number("radius", Range::positive(), std::nullopt, "m")});
+      po.finish();
+    }
+    if (pebbles.empty())
+      o.fail("pebbles", "give at least one pebble");
+  } else {
+    const std::string name =
+        o.choice("template", {"single", "pair", "line3", "triangle3", "tetra4"});
+    if (dim == 2 && name == "tetra4")
+      o.fail("template", "\"tetra4\" is a 3D template");
+    const double r = o.number("radius", Range::positive(), std::nullopt, "m");
+    const Vec3 at =
+        position_required ? o.vec("position", dim) : o.vec("position", dim, Vec3::Zero());
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+    constexpr double deg = 3.14159265358979323846 / 180.0;
+    if (dim == 2) {
+      R = Eigen::AngleAxisd(o.number("rotation", Range::any(), 0.0, "deg") * deg, Vec3::UnitZ())
+              .toRotationMatrix();
+    } else {
+      const Vec3 phi = o.vec("rotation", dim, Vec3::Zero()) * deg;
+      if (phi.norm() > 0)
+        R = Eigen::AngleAxisd(phi.norm(), phi.normalized()).toRotationMatrix();
+    }
+    for (const Pebble& p : clump_template(name, dim))
+      pebbles.push_back({at + R * (p.position * r), r});
+  }
+  return pebbles;
+}
+
+ModelProps read_contact_props(JsonObject& p, const std::string& model, int dim) {
+  return read_model_props(p, model, dim);
+}
 
 Scene load_scene(const std::string& path) {
   Scene s;

@@ -89,6 +89,13 @@ struct EventCounts {
 /// `groups` is Model::group_energy(), needed only by group columns (may be empty otherwise).
 double history_value(const Model& m, const HistoryColumn& c, const EnergyLedger& e,
                      const EventCounts& counts, const std::vector<EnergyLedger>& groups);
+/// The pebbles of one clump entry: 'pebbles' (a list of {position, radius}, global) or
+/// 'template' + 'radius' (+ 'position' of the pebble centres' centroid, 'rotation': 2D degrees
+/// about z, 3D a rotation vector in degrees). Reads only those keys.
+std::vector<Pebble> read_clump_pebbles(JsonObject& o, int dim, bool position_required);
+/// The properties of one contact model ("linear", "hysteretic", "powerplastic", ...) from the
+/// keys of a contact_models entry (docs/scene-format.md).
+ModelProps read_contact_props(JsonObject& p, const std::string& model, int dim);
 /// One energy partition by name (energy/NAME columns); throws std::out_of_range if unknown.
 double energy_partition(const EnergyLedger& e, const std::string& name);
 
