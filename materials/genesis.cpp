@@ -260,6 +260,7 @@ nlohmann::json GenesisReport::to_json() const {
             {"flatjoint_gapped", fj_gapped},
             {"flatjoint_slit", fj_slit},
             {"linearpbond_bonded", pb_bonded},
+            {"contactbond_bonded", cb_bonded},
             {"linear", linear},
             {"smoothjoint", smoothjoint}}},
           {"installation_pressure_Pa", pressure},
@@ -645,6 +646,17 @@ GenesisResult run_genesis(const MaterialCard& card,
       std::min(N - n_bonded,
                static_cast<std::size_t>(std::llround(card.frac_gapped * static_cast<double>(N))));
   std::vector<bool> is_bond(m.contacts().size(), false);
+  // A bonded model (parallel or contact bond) on the card's linear component, bonded now.
+  auto install_bond = [&](std::size_t ci, auto props, std::int64_t& count) {
+    const double rgap = props.linear.rgap;
+    props.linear = card.linear;
+    props.linear.rgap = rgap;
+    props.bond = true;
+    props.bond_gap_lo = -1e300;
+    props.bond_gap_hi = 1e300; // the candidate test above already applied g <= g_i
+    m.replace_contact_model(ci, props);
+    ++count;
+  };
   for (std::size_t k = 0; k < N; ++k) {
     const std::size_t ci = candidates[k];
     is_bond[ci] = true;
@@ -668,14 +680,17 @@ GenesisResult run_genesis(const MaterialCard& card,
       m.replace_contact_model(ci, fj);
     } else if (card.bonding == MaterialCard::Bonding::ParallelBond) {
       PBondProps pb = card.pb;
-      pb.linear = card.linear;
       pb.pb_ten = normal(rng, card.pb_ten);
       pb.pb_coh = normal(rng, card.pb_coh);
-      pb.bond = true;
-      pb.bond_gap_lo = -1e300;
-      pb.bond_gap_hi = 1e300; // the candidate test above already applied g <= g_i
-      m.replace_contact_model(ci, pb);
-      ++rep.pb_bonded;
+      install_bond(ci, pb, rep.pb_bonded);
+    } else if (card.bonding == MaterialCard::Bonding::ContactBond) {
+      ContactBondProps cb;
+      // A point bond made across an open gap would start in tension (its normal force is
+      // kn (g - g_r)); the reference gap makes the bonded gap the contact's rest state.
+      cb.linear.rgap = std::max(m.contacts()[ci].gap, 0.0);
+      cb.cb_tenf = normal(rng, card.cb_tenf);
+      cb.cb_shearf = normal(rng, card.cb_shearf);
+      install_bond(ci, cb, rep.cb_bonded);
     } else {
       is_bond[ci] = false;
     }

@@ -238,9 +238,9 @@ MaterialCard load_material_card(const std::string& path) {
     i.finish();
   }
   c.linear = read_linear(top.object("linear"));
-  const int bonds = top.has("flatjoint") + top.has("parallelbond");
+  const int bonds = top.has("flatjoint") + top.has("parallelbond") + top.has("contactbond");
   if (bonds > 1)
-    top.fail("flatjoint", "give one of 'flatjoint' or 'parallelbond'");
+    top.fail("flatjoint", "give one of 'flatjoint', 'parallelbond' or 'contactbond'");
   if (top.has("flatjoint")) {
     c.bonding = MaterialCard::Bonding::FlatJoint;
     JsonObject f = top.object("flatjoint");
@@ -277,6 +277,13 @@ MaterialCard load_material_card(const std::string& path) {
     c.pb_ten = read_dist(p, "pb_ten", "Pa");
     c.pb_coh = read_dist(p, "pb_coh", "Pa");
     p.finish();
+  } else if (top.has("contactbond")) {
+    // PFC's contact bond on the linear contact: point-bond strengths in force units.
+    c.bonding = MaterialCard::Bonding::ContactBond;
+    JsonObject b = top.object("contactbond");
+    c.cb_tenf = read_dist(b, "cb_tenf", "N");
+    c.cb_shearf = read_dist(b, "cb_shearf", "N");
+    b.finish();
   } else {
     c.bonding = MaterialCard::Bonding::None;
   }

@@ -63,13 +63,14 @@ struct MaterialCard {
   double install_gap = 0; ///< g_i [m]
   // contacts
   LinearProps linear; ///< grain-wall, non-bonded and new contacts
-  enum class Bonding { FlatJoint, ParallelBond, None } bonding = Bonding::FlatJoint;
+  enum class Bonding { FlatJoint, ParallelBond, ContactBond, None } bonding = Bonding::FlatJoint;
   FlatJointProps fj;
   Distribution fj_ten, fj_coh;
   double frac_bonded = 1, frac_gapped = 0, frac_slit = 0;
   Distribution gapped_gap; ///< g_o of gapped contacts [m]
   PBondProps pb;
   Distribution pb_ten, pb_coh;
+  Distribution cb_tenf, cb_shearf; ///< contact-bond strengths [N] (rock-impact thesis 4.3-4.4)
   // release
   double residual_tolerance = 0.05; ///< mean residual stress / pressure after release
   bool eliminate_floaters = false;

@@ -42,8 +42,8 @@ double grain_volume_sum(const Model& m) {
 
 TEST(Genesis, PorosityStressAndReleaseForEveryShape) {
   for (const char* name :
-       {"genesis_2d_rect.json", "genesis_2d_rect_pb.json", "genesis_2d_disk.json",
-        "genesis_3d_prism.json", "genesis_3d_disk.json"}) {
+       {"genesis_2d_rect.json", "genesis_2d_rect_pb.json", "genesis_2d_rect_cb.json",
+        "genesis_2d_disk.json", "genesis_3d_prism.json", "genesis_3d_disk.json"}) {
     const MaterialCard c = load_material_card(card(name));
     const GenesisResult g = run_genesis(c);
     const GenesisReport& r = g.report;
@@ -75,6 +75,22 @@ TEST(Genesis, PorosityStressAndReleaseForEveryShape) {
       for (const auto& fj : g.model->batches().flatjoint)
         bonded += fj.mtype == 1;
       EXPECT_EQ(bonded, r.fj_bonded) << name;
+    } else if (c.bonding == MaterialCard::Bonding::ContactBond) {
+      EXPECT_GT(r.cb_bonded, 0) << name;
+      EXPECT_EQ(r.pb_bonded, 0) << name;
+      std::int64_t bonded = 0;
+      double tenf = 0;
+      for (const auto& cb : g.model->batches().contactbond) {
+        bonded += cb.state == 3;
+        tenf += cb.state == 3 ? cb.tenf : 0;
+      }
+      int st[4] = {0, 0, 0, 0};
+      for (const auto& cb : g.model->batches().contactbond)
+        ++st[cb.state];
+      // Every installed bond is still there or broke while the vessel was released (a few).
+      EXPECT_EQ(bonded + st[1] + st[2], r.cb_bonded) << name;
+      EXPECT_LE(st[1] + st[2], r.cb_bonded / 100) << name;
+      EXPECT_NEAR(tenf / static_cast<double>(bonded), 5e4, 1.5e3) << name; // drawn N(5e4, 5e3) N
     } else {
       EXPECT_GT(r.pb_bonded, 0) << name;
       std::int64_t bonded = 0;
