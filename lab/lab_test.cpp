@@ -350,6 +350,9 @@ void Machine::setup() {
     }
     if (grip_top_.empty() || grip_bottom_.empty())
       throw InputError(p_.file + ": key 'loading.grip_fraction': a grip holds no grains");
+    if (!m_.clumps.empty())
+      throw InputError(p_.file + ": key 'test': the direct-tension grips hold single grains; this "
+                                 "specimen has clumps (not supported yet)");
     for (const auto* list : {&grip_top_, &grip_bottom_})
       for (std::int32_t i : *list) {
         const auto k = static_cast<std::size_t>(i);

@@ -261,6 +261,7 @@ nlohmann::json GenesisReport::to_json() const {
             {"flatjoint_slit", fj_slit},
             {"linearpbond_bonded", pb_bonded},
             {"contactbond_bonded", cb_bonded},
+            {"clumps", clumps},
             {"linear", linear},
             {"smoothjoint", smoothjoint}}},
           {"installation_pressure_Pa", pressure},
@@ -625,6 +626,83 @@ GenesisResult run_genesis(const MaterialCard& card,
     rep.coordination = live > 0 ? 2.0 * static_cast<double>(bb) / live : 0;
     if (card.eliminate_floaters && rep.floaters > 0)
       m.remove_balls(floater);
+  }
+
+  if (card.clump_max > 1) {
+    // Clumps (thesis Appendix B): in a seeded random order, each free grain takes up to
+    // clump_max - 1 free grains it touches (in contact order) and the group becomes one rigid
+    // body with the grains as pebbles, mass and inertia of their union.
+    say("joining grains into clumps");
+    const std::size_t n = m.balls.size();
+    std::vector<std::vector<std::int32_t>> touching(n);
+    for (std::size_t ci = 0; ci < m.contacts().size(); ++ci) {
+      const Contact& c = m.contacts()[ci];
+      if (c.kind == ContactKind::BallBall && c.gap <= 0) {
+        touching[static_cast<std::size_t>(c.end1)].push_back(c.end2);
+        touching[static_cast<std::size_t>(c.end2)].push_back(c.end1);
+      }
+    }
+    std::vector<std::size_t> order(n);
+    for (std::size_t i = 0; i < n; ++i)
+      order[i] = i;
+    for (std::size_t i = n; i > 1; --i)
+      std::swap(order[i - 1],
+                order[static_cast<std::size_t>(uniform01(rng) * static_cast<double>(i))]);
+    std::vector<bool> taken(n, false), remove(n, false);
+    std::vector<std::vector<std::size_t>> groups;
+    for (std::size_t i : order) {
+      if (taken[i])
+        continue;
+      std::vector<std::size_t> g{i};
+      taken[i] = true;
+      for (std::int32_t j : touching[i]) {
+        if (static_cast<int>(g.size()) >= card.clump_max)
+          break;
+        if (!taken[static_cast<std::size_t>(j)]) {
+          taken[static_cast<std::size_t>(j)] = true;
+          g.push_back(static_cast<std::size_t>(j));
+        }
+      }
+      if (g.size() > 1) {
+        for (std::size_t k : g)
+          remove[k] = true;
+        groups.push_back(std::move(g));
+      }
+    }
+    struct Pending {
+      std::vector<Pebble> pebbles;
+      Vec3 vel;
+      int group;
+      std::int64_t first_id;
+      std::vector<std::int64_t> ids;
+    };
+    std::vector<Pending> pending;
+    for (const auto& g : groups) {
+      Pending p;
+      p.vel = Vec3::Zero();
+      for (std::size_t k : g) {
+        p.pebbles.push_back({m.balls.pos[k], m.balls.radius[k]});
+        p.vel += m.balls.vel[k] / static_cast<double>(g.size());
+        p.ids.push_back(m.balls.id[k]);
+      }
+      p.group = m.balls.group[g[0]];
+      pending.push_back(std::move(p));
+    }
+    m.remove_balls(remove);
+    std::int64_t next_id = 1;
+    for (std::int64_t id : m.balls.id)
+      next_id = std::max(next_id, id + 1);
+    for (const Pending& p : pending)
+      for (std::int64_t id : p.ids)
+        next_id = std::max(next_id, id + 1);
+    std::int64_t clump_id = 1;
+    for (const Pending& p : pending) {
+      m.add_clump(p.pebbles, card.density, p.group, clump_id++, next_id, p.vel, Vec3::Zero());
+      next_id += static_cast<std::int64_t>(p.pebbles.size());
+    }
+    m.set_margin(m.margin()); // detect the contacts of the new pebbles
+    m.cycle(1);
+    rep.clumps = static_cast<std::int64_t>(m.clumps.size());
   }
 
   // Finalization: bonds at grain-grain contacts with gap <= g_i, linear elsewhere.

@@ -16,7 +16,7 @@ struct GenesisReport {
   int dim = 3;
   std::int64_t grains = 0, floaters = 0;
   std::int64_t contacts = 0, fj_bonded = 0, fj_gapped = 0, fj_slit = 0, pb_bonded = 0,
-               cb_bonded = 0, linear = 0, smoothjoint = 0;
+               cb_bonded = 0, clumps = 0, linear = 0, smoothjoint = 0;
   ShapeSpec shape; ///< the specimen: the vessel at the end of installation, or the cut [m]
   double porosity_target = 0;
   double porosity_packed = 0;    ///< when the friction control reached the target

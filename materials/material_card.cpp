@@ -204,6 +204,14 @@ MaterialCard load_material_card(const std::string& path) {
   c.vessel = read_shape(top.object("specimen"), c.dim);
   if (top.has("cut"))
     c.cut = read_shape(top.object("cut"), c.dim);
+  if (top.has("clumps")) {
+    JsonObject k = top.object("clumps");
+    c.clump_max = static_cast<int>(k.integer("max_pebbles", 2, 8));
+    if (c.cut)
+      k.fail("max_pebbles", "clumped grains cannot be cut from a block (a cut would split "
+                            "clumps); leave out 'cut'");
+    k.finish();
+  }
   {
     JsonObject p = top.optional_object("packing");
     c.packing_method = p.choice("method", {"contraction", "scaling"}, "contraction") == "scaling"

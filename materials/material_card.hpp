@@ -74,6 +74,9 @@ struct MaterialCard {
   // release
   double residual_tolerance = 0.05; ///< mean residual stress / pressure after release
   bool eliminate_floaters = false;
+  /// > 1: before bonding, touching grains are joined into rigid clumps of up to this many
+  /// pebbles (rock-impact thesis Appendix B); 0: single grains.
+  int clump_max = 0;
   std::vector<JointSpec> joints;
 };
 

@@ -260,3 +260,42 @@ TEST(Genesis, BadCardsFailClearlyAndWriteNothing) {
     EXPECT_FALSE(fs::exists(out.string() + ".partial"));
   }
 }
+
+TEST(Genesis, ClumpedContactBondedSpecimen) {
+  // Thesis Appendix B: grains joined into rigid clumps of up to three, contact-bonded.
+  const MaterialCard c = load_material_card(
+      edited_card("genesis_2d_rect_cb.json",
+                  "\"linear\":", "\"clumps\": {\"max_pebbles\": 3},\n  \"linear\":"));
+  ASSERT_EQ(c.clump_max, 3);
+  const GenesisResult g = run_genesis(c);
+  const Model& m = *g.model;
+  ASSERT_GT(m.clumps.size(), 20u);
+  EXPECT_EQ(g.report.clumps, static_cast<std::int64_t>(m.clumps.size()));
+  std::size_t pebbles = 0;
+  for (const Clump& k : m.clumps) {
+    EXPECT_GE(k.pebbles.size(), 2u);
+    EXPECT_LE(k.pebbles.size(), 3u);
+    pebbles += k.pebbles.size();
+    for (std::int32_t p : k.pebbles)
+      EXPECT_EQ(m.balls.clump[static_cast<std::size_t>(p)], &k - m.clumps.data());
+  }
+  EXPECT_GT(pebbles, m.balls.size() / 2); // most grains are in a clump
+  // No contact inside a clump; bonds join clumps and single grains.
+  for (const Contact& ct : m.contacts())
+    if (ct.kind == ContactKind::BallBall) {
+      const std::int32_t a = m.balls.clump[static_cast<std::size_t>(ct.end1)];
+      EXPECT_TRUE(a < 0 || a != m.balls.clump[static_cast<std::size_t>(ct.end2)]);
+    }
+  EXPECT_GT(g.report.cb_bonded, 100);
+  EXPECT_NEAR(g.report.porosity, c.porosity, 0.005);
+  // The specimen file keeps the clumps.
+  const fs::path f = scratch("clumped");
+  save_model(m, f.string());
+  const auto back = load_model(f.string());
+  ASSERT_EQ(back->clumps.size(), m.clumps.size());
+  for (std::size_t k = 0; k < m.clumps.size(); ++k) {
+    EXPECT_EQ(back->clumps[k].pebbles, m.clumps[k].pebbles);
+    EXPECT_EQ(back->clumps[k].mass, m.clumps[k].mass);
+    EXPECT_EQ(back->clumps[k].q.coeffs(), m.clumps[k].q.coeffs());
+  }
+}
