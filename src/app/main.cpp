@@ -122,7 +122,8 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
         "contact bonds %lld; linear %lld; smooth joints %lld\n",
         static_cast<long long>(r.fj_bonded), static_cast<long long>(r.fj_gapped),
         static_cast<long long>(r.fj_slit), static_cast<long long>(r.pb_bonded),
-        static_cast<long long>(r.cb_bonded), static_cast<long long>(r.linear), static_cast<long long>(r.smoothjoint));
+        static_cast<long long>(r.cb_bonded), static_cast<long long>(r.linear),
+        static_cast<long long>(r.smoothjoint));
     std::printf("stress [Pa]  requested %.4g;", r.pressure);
     for (const auto& [name, s] : r.wall_stress)
       std::printf(" %s %.4g", name.c_str(), s);
