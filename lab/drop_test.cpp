@@ -34,6 +34,24 @@ DropProtocol drop_protocol_from_json(const nlohmann::json& j, const std::string&
     JsonObject r = top.object("rock");
     p.density = r.number("density", Range::positive(), std::nullopt, "kg/m^3");
     p.rock = read_clump_pebbles(r, p.dim, false);
+    if (r.has("bond")) {
+      JsonObject b = r.object("bond");
+      p.bonded = true;
+      p.bond_model = b.choice("model", {"contactbond", "linearpbond"});
+      JsonObject props = b.object("properties");
+      p.bond = read_contact_props(props, p.bond_model, p.dim);
+      // Template pebbles touch at a gap of round-off size: bond them.
+      double rmin = std::numeric_limits<double>::infinity();
+      for (const Pebble& q : p.rock)
+        rmin = std::min(rmin, q.radius);
+      if (auto* cb = std::get_if<ContactBondProps>(&p.bond))
+        cb->bond_gap_hi = std::max(cb->bond_gap_hi, 1e-9 * rmin);
+      if (auto* pb = std::get_if<PBondProps>(&p.bond))
+        pb->bond_gap_hi = std::max(pb->bond_gap_hi, 1e-9 * rmin);
+      b.finish();
+      if (p.rock.size() < 2)
+        r.fail("bond", "a bonded rock needs at least two pebbles");
+    }
     r.finish();
   }
   {
@@ -91,6 +109,11 @@ DropProtocol drop_protocol_from_json(const nlohmann::json& j, const std::string&
 
 namespace {
 
+struct RockState {
+  Vec3 pos = Vec3::Zero(), vel = Vec3::Zero(), spin = Vec3::Zero();
+  double ke = 0, ke_rot = 0; ///< kinetic energy, total and rotational [J]
+};
+
 Wall platen(int dim, double extent) {
   Wall w;
   w.name = "platen";
@@ -144,16 +167,59 @@ DropResult run_drop(const DropProtocol& p, double speed, double exponent, std::s
     q.position += (p.release_gap - lowest) * up;
   const double v0 = std::sqrt(std::max(0.0, speed * speed - 2 * p.gravity * p.release_gap));
   const int g = m.group_index("rock");
-  m.add_clump(rock, p.density, g, 1, 1, -v0 * up, Vec3::Zero());
+  if (p.bonded) {
+    ModelRule bb;
+    bb.props = p.bond;
+    m.rules.push_back(bb);
+    for (std::size_t k = 0; k < rock.size(); ++k) {
+      const std::size_t i = m.balls.add(dim, static_cast<std::int64_t>(k) + 1, rock[k].position,
+                                        rock[k].radius, p.density, g);
+      m.balls.vel[i] = -v0 * up;
+    }
+  } else {
+    m.add_clump(rock, p.density, g, 1, 1, -v0 * up, Vec3::Zero());
+  }
   m.initialize();
-  const Clump& c = m.clumps[0];
+  m.settings.slip_events = false;
+  std::vector<Event> events;
+  // The rock as one body: a clump, or the bonded balls' centre of mass.
+  RockState c;
+  auto update_rock = [&] {
+    if (!p.bonded) {
+      const Clump& k = m.clumps[0];
+      c = {k.pos, k.vel, k.spin, k.kinetic_translational() + k.kinetic_rotational(),
+           k.kinetic_rotational()};
+      return;
+    }
+    double mass = 0;
+    Vec3 x = Vec3::Zero(), v = Vec3::Zero();
+    for (std::size_t i = 0; i < m.balls.size(); ++i) {
+      mass += m.balls.mass[i];
+      x += m.balls.mass[i] * m.balls.pos[i];
+      v += m.balls.mass[i] * m.balls.vel[i];
+    }
+    x /= mass;
+    v /= mass;
+    Vec3 L = Vec3::Zero();
+    double I = 0, ke = 0, ke_rot = 0;
+    for (std::size_t i = 0; i < m.balls.size(); ++i) {
+      const Vec3 r = m.balls.pos[i] - x;
+      L += m.balls.mass[i] * r.cross(m.balls.vel[i] - v) + m.balls.inertia[i] * m.balls.spin[i];
+      I += m.balls.mass[i] * r.squaredNorm() + m.balls.inertia[i];
+      ke += 0.5 * m.balls.mass[i] * m.balls.vel[i].squaredNorm() +
+            0.5 * m.balls.inertia[i] * m.balls.spin[i].squaredNorm();
+    }
+    ke_rot = ke - 0.5 * mass * v.squaredNorm();
+    c = {x, v, L / I, ke, ke_rot}; // spin: the mean angular velocity about the centre of mass
+  };
+  update_rock();
   auto touching = [&] {
     for (const Contact& k : m.contacts())
-      if (k.gap < 0)
+      if (k.kind == ContactKind::BallFacet && k.gap < 0)
         return true;
     return false;
   };
-  auto ke = [&] { return c.kinetic_translational() + c.kinetic_rotational(); };
+  auto ke = [&] { return c.ke; };
   EnergyLedger e0 = m.energy(), e_snap;
   Vec3 prev_vel = c.vel;
   double prev_ke = ke(), t_first = 0, snap_height = 0;
@@ -178,6 +244,11 @@ DropResult run_drop(const DropProtocol& p, double speed, double exponent, std::s
       e0 = m.energy();
     }
     m.cycle(1);
+    events.clear();
+    m.drain_events(events);
+    for (const Event& ev : events)
+      r.bonds_broken += ev.type == EventType::BondBreak ? 1 : 0;
+    update_rock();
     const bool t = touching();
     r.max_force = std::max(r.max_force, m.walls[0].force.norm());
     if (!touched && t) {
@@ -199,7 +270,7 @@ DropResult run_drop(const DropProtocol& p, double speed, double exponent, std::s
         snap.v_tangential = (c.vel - c.vel.dot(up) * up).norm();
         snap.spin = c.spin.norm();
         snap.ke_after = ke();
-        snap.ke_rotational_after = c.kinetic_rotational();
+        snap.ke_rotational_after = c.ke_rot;
         snap.contact_time = m.time() - t_first;
         e_snap = m.energy();
       }
@@ -214,6 +285,35 @@ DropResult run_drop(const DropProtocol& p, double speed, double exponent, std::s
   }
   row();
   r.steps = m.step();
+  if (p.bonded) {
+    // Fragments: balls joined by unbroken bonds (union-find over the bonded contacts).
+    std::vector<std::size_t> parent(m.balls.size());
+    for (std::size_t i = 0; i < parent.size(); ++i)
+      parent[i] = i;
+    auto root = [&](std::size_t i) {
+      while (parent[i] != i)
+        i = parent[i] = parent[parent[i]];
+      return i;
+    };
+    for (const Contact& k : m.contacts()) {
+      if (k.kind != ContactKind::BallBall)
+        continue;
+      bool intact = false;
+      if (k.model == ModelKind::ContactBond)
+        intact = m.batches().contactbond[k.slot].state == 3;
+      else if (k.model == ModelKind::PBond)
+        intact = m.batches().pbond[k.slot].s.state == 3;
+      if (intact)
+        parent[root(static_cast<std::size_t>(k.end1))] = root(static_cast<std::size_t>(k.end2));
+    }
+    std::vector<double> mass(parent.size(), 0.0);
+    for (std::size_t i = 0; i < parent.size(); ++i)
+      mass[root(i)] += m.balls.mass[i];
+    for (double x : mass)
+      if (x > 0)
+        r.fragments.push_back(x);
+    std::sort(r.fragments.begin(), r.fragments.end(), std::greater<>());
+  }
   if (!done) {
     // Still on the platen (or never reached it) at max_time: no rebound.
     e_snap = m.energy();
@@ -264,6 +364,10 @@ nlohmann::json to_json(const DropResult& r, bool calibrated) {
                    {"steps", r.steps}};
   if (r.exponent > 0)
     j["exponent"] = r.exponent;
+  if (!r.fragments.empty())
+    j["fragments"] = {{"count", r.fragments.size()},
+                      {"masses_kg", r.fragments},
+                      {"bonds_broken", r.bonds_broken}};
   if (calibrated)
     j["target_restitution"] = r.target;
   return j;

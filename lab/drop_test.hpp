@@ -21,8 +21,13 @@ struct DropProtocol {
   std::string file;
   int dim = 2;
   std::vector<Pebble> rock; ///< pebbles, rock at the origin
-  double density = 2600;    ///< [kg/m^3]
-  std::string model;        ///< rock-platen contact model name
+  /// A bonded rock: the pebbles are separate balls joined by this bonded model (contactbond or
+  /// linearpbond, bonded where they touch) and can break into fragments; otherwise one clump.
+  bool bonded = false;
+  std::string bond_model;
+  ModelProps bond;
+  double density = 2600; ///< [kg/m^3]
+  std::string model;     ///< rock-platen contact model name
   ModelProps contact;
   std::vector<double> speeds; ///< impact speeds [m/s]
   double gravity = 9.81;      ///< [m/s^2], acting against the platen normal
@@ -54,13 +59,15 @@ struct DropResult {
   double e_energy = 0;     ///< sqrt(KE after / KE before), translation + rotation (Eq. 24)
   double ke_before = 0, ke_after = 0, ke_rotational_after = 0; ///< [J]
   double plastic = 0, slip = 0, dashpot = 0, damping = 0,
-         bond_break = 0;   ///< lost in the impact [J]
-  double contact_time = 0; ///< from first touch to leaving [s]
-  double max_force = 0;    ///< largest platen force [N]
-  int touches = 0;         ///< contact episodes before leaving (rocking clumps touch again)
-  bool rebounded = false;  ///< false: the rock stayed on the platen within max_time
-  double exponent = 0;     ///< b used (powerplastic)
-  double target = 0;       ///< Eq. 35 restitution at this speed (calibration)
+         bond_break = 0;         ///< lost in the impact [J]
+  double contact_time = 0;       ///< from first touch to leaving [s]
+  double max_force = 0;          ///< largest platen force [N]
+  int touches = 0;               ///< contact episodes before leaving (rocking clumps touch again)
+  int bonds_broken = 0;          ///< bonded rock: bonds broken in the drop
+  std::vector<double> fragments; ///< bonded rock: fragment masses at the end, largest first [kg]
+  bool rebounded = false;        ///< false: the rock stayed on the platen within max_time
+  double exponent = 0;           ///< b used (powerplastic)
+  double target = 0;             ///< Eq. 35 restitution at this speed (calibration)
   std::int64_t steps = 0;
 };
 

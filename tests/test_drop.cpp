@@ -116,3 +116,41 @@ TEST(DropTest, BadDropProtocolsFailClearlyAndWriteNothing) {
     EXPECT_FALSE(fs::exists(out)) << k.j.dump();
   }
 }
+
+TEST(DropTest, BondedRockBreaksIntoFragments) {
+  // Three contact-bonded pebbles (not a clump): weak bonds break at a 10 m/s impact, strong
+  // ones hold; fragment masses add up to the rock.
+  const double pebble = 2600 * 4.0 / 3.0 * M_PI * std::pow(0.04, 3);
+  for (double tenf : {50.0, 1e9}) {
+    nlohmann::json j = drop_card(4.5, {10.0});
+    j["rock"] = {{"template", "triangle3"},
+                 {"radius", 0.04},
+                 {"density", 2600},
+                 {"rotation", {90, 0, 0}},
+                 {"bond",
+                  {{"model", "contactbond"},
+                   {"properties",
+                    {{"kn", 6.4e10},
+                     {"ks", 9.6e9},
+                     {"fric", 0.5},
+                     {"cb_tenf", tenf},
+                     {"cb_shearf", 2 * tenf}}}}}};
+    const DropProtocol p = drop_protocol_from_json(j, "card.json");
+    ASSERT_TRUE(p.bonded);
+    const DropResult r = run_drop(p, 10.0);
+    ASSERT_TRUE(r.rebounded);
+    double total = 0;
+    for (double f : r.fragments)
+      total += f;
+    EXPECT_TRUE(near_rel(total, 3 * pebble, 1e-12));
+    if (tenf < 1e3) {
+      EXPECT_EQ(r.bonds_broken, 3);
+      EXPECT_EQ(r.fragments.size(), 3u);
+      EXPECT_GT(r.bond_break, 0);
+    } else {
+      EXPECT_EQ(r.bonds_broken, 0);
+      EXPECT_EQ(r.fragments.size(), 1u);
+    }
+    EXPECT_TRUE(near_rel(r.e_energy, 0.4236, 0.01)); // the platen contact still sets e
+  }
+}
