@@ -1305,7 +1305,8 @@ LabSummary run_lab_test(const Protocol& p, const LabOptions& o) {
     write_text_file(out.staged("stress_strain.svg"),
                     line_plot_svg(title, xlabel, ylabel, "cracks", series));
     write_text_file(out.staged("crack_map.svg"),
-                    crack_map_svg(machine.snapshot(), title + ", cracks at the end"));
+                    crack_map_svg(machine.snapshot(), title + ", cracks at the end",
+                                  p.type == TestType::Brazilian ? 2 : 1));
     sum.files.insert(sum.files.end(), {"stress_strain.svg", "crack_map.svg"});
   }
   nlohmann::json files = sum.files;

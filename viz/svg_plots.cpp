@@ -152,25 +152,26 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
   return s;
 }
 
-std::string crack_map_svg(const Snapshot& snap, const std::string& title) {
-  // View: 2D as is (x right, y up). 3D: a thin section through the centre, seen along y (x right,
-  // z up): the grains and cracks within 10 % of the specimen's y extent of the mid-plane, each
-  // crack drawn as its trace (a segment across the projected normal; a circle when it lies in
-  // the section plane).
-  const int vx = 0, vy = snap.dim == 2 ? 1 : 2;
+std::string crack_map_svg(const Snapshot& snap, const std::string& title, int depth_axis) {
+  // View: 2D as is (x right, y up). 3D: a thin section through the centre, seen along the depth
+  // axis (y: x right, z up; z: x right, y up): the grains and cracks within 10 % of the
+  // specimen's depth extent of the mid-plane, each crack drawn as its trace (a segment across the
+  // projected normal; a circle when it lies in the section plane).
+  const int dz = snap.dim == 2 ? 2 : depth_axis;
+  const int vx = 0, vy = snap.dim == 2 ? 1 : (dz == 1 ? 2 : 1);
   double xlo = 1e300, xhi = -1e300, ylo = 1e300, yhi = -1e300, dlo = 1e300, dhi = -1e300;
   for (std::size_t i = 0; i < snap.pos.size(); ++i) {
     xlo = std::min(xlo, snap.pos[i][vx] - snap.radius[i]);
     xhi = std::max(xhi, snap.pos[i][vx] + snap.radius[i]);
     ylo = std::min(ylo, snap.pos[i][vy] - snap.radius[i]);
     yhi = std::max(yhi, snap.pos[i][vy] + snap.radius[i]);
-    dlo = std::min(dlo, snap.pos[i].y() - snap.radius[i]);
-    dhi = std::max(dhi, snap.pos[i].y() + snap.radius[i]);
+    dlo = std::min(dlo, snap.pos[i][dz] - snap.radius[i]);
+    dhi = std::max(dhi, snap.pos[i][dz] + snap.radius[i]);
   }
   if (xlo > xhi)
     xlo = 0, xhi = 1, ylo = 0, yhi = 1, dlo = dhi = 0;
   const double mid = 0.5 * (dlo + dhi), half = 0.1 * (dhi - dlo);
-  auto in_section = [&](const Vec3& p) { return snap.dim == 2 || std::abs(p.y() - mid) <= half; };
+  auto in_section = [&](const Vec3& p) { return snap.dim == 2 || std::abs(p[dz] - mid) <= half; };
   const double margin = 20, top = 40, maxw = 640, maxh = 800;
   const double scale = std::min(maxw / (xhi - xlo), maxh / (yhi - ylo));
   const double W = (xhi - xlo) * scale + 2 * margin, H = (yhi - ylo) * scale + top + 2 * margin;
@@ -189,7 +190,7 @@ std::string crack_map_svg(const Snapshot& snap, const std::string& title) {
     // 3D: the grain's cut by the mid-plane (at least a third of its radius, to stay visible)
     double r = snap.radius[i];
     if (snap.dim == 3) {
-      const double d = snap.pos[i].y() - mid;
+      const double d = snap.pos[i][dz] - mid;
       r = std::sqrt(std::max(r * r - d * d, r * r / 9));
     }
     s += "<circle cx=\"" + num(X(snap.pos[i][vx])) + "\" cy=\"" + num(Y(snap.pos[i][vy])) +
@@ -220,8 +221,8 @@ std::string crack_map_svg(const Snapshot& snap, const std::string& title) {
        "\" fill=\"#d62728\">tension</text><text x=\"" + num(margin + 70) + "\" y=\"" + num(H - 6) +
        "\" fill=\"#1f3fbf\">shear</text>\n";
   if (snap.dim == 3)
-    s += "<text x=\"" + num(margin) + "\" y=\"" + num(H + 10) +
-         "\" fill=\"#555555\">section |y - " + num(1e3 * mid) + " mm| &lt;= " + num(1e3 * half) +
+    s += "<text x=\"" + num(margin) + "\" y=\"" + num(H + 10) + "\" fill=\"#555555\">section |" +
+         std::string(1, "xyz"[dz]) + " - " + num(1e3 * mid) + " mm| &lt;= " + num(1e3 * half) +
          " mm: " + std::to_string(shown) + " of " + std::to_string(snap.cracks.size()) +
          " cracks</text>\n";
   s += "</svg>\n";

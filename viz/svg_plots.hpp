@@ -28,8 +28,9 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
                           const std::vector<PlotSeries>& series,
                           const std::vector<PlotMarker>& markers = {});
 
-/// The cracks of a snapshot over its grains: 2D as it is; 3D seen along y (x right, z up), with
-/// each crack disk drawn as its projected ellipse. Red: tension, blue: shear.
-std::string crack_map_svg(const Snapshot& s, const std::string& title);
+/// The cracks of a snapshot over its grains: 2D as it is; 3D a central section seen along
+/// `depth_axis` (1: y, x right and z up; 2: z, x right and y up — a Brazilian disk's faces),
+/// each crack drawn as its trace. Red: tension, blue: shear.
+std::string crack_map_svg(const Snapshot& s, const std::string& title, int depth_axis = 1);
 
 } // namespace rocklab
