@@ -204,3 +204,56 @@ TEST(ContactBond, BreaksInShearWithoutSlippingFirst) {
   EXPECT_GT(r.max_shear, shearf - kn * v * 1e-6 * 1.01);
   EXPECT_LT(r.max_shear, shearf);
 }
+
+TEST(ImpactModels, HystereticBondCarriesTensionUntilItsStrength) {
+  // Two touching spheres pulled apart at a constant speed: bonded, the hysteretic contact pulls
+  // back with K_unload until the tension reaches hys_tenf, then the bond breaks once; unbonded it
+  // never carries tension.
+  for (double tenf : {0.0, 500.0}) {
+    Model m;
+    m.settings.dim = 3;
+    m.settings.local_damping = 0;
+    m.settings.timestep = 1e-7;
+    const double R = 0.01;
+    const std::size_t a = m.balls.add(3, 1, Vec3(-R, 0, 0), R, 2600, 0);
+    const std::size_t b = m.balls.add(3, 2, Vec3(R, 0, 0), R, 2600, 0);
+    for (std::size_t i : {a, b})
+      m.balls.fixity[i] = 0x3f;
+    m.balls.vel[a] = Vec3(-0.1, 0, 0);
+    m.balls.vel[b] = Vec3(0.1, 0, 0);
+    HysteresisProps h;
+    h.hys_knm = 1e7;
+    h.hys_dampn = 0.5;
+    h.hys_ks = 5e6;
+    h.hys_tenf = tenf;
+    h.hys_shearf = 2 * tenf;
+    ModelRule r;
+    r.props = h;
+    m.rules.push_back(r);
+    m.initialize();
+    ASSERT_EQ(m.contacts().size(), 1u);
+    double max_tension = 0;
+    std::int64_t breaks = 0;
+    std::vector<Event> ev;
+    for (int k = 0; k < 3000; ++k) {
+      m.cycle(1);
+      ev.clear();
+      m.drain_events(ev);
+      for (const Event& e : ev)
+        breaks += e.type == EventType::BondBreak;
+      for (std::size_t ci = 0; ci < m.contacts().size(); ++ci)
+        max_tension =
+            std::max(max_tension, local_components(m.contacts()[ci], m.contact_outputs()[ci]).Fn);
+    }
+    if (tenf == 0) {
+      EXPECT_EQ(max_tension, 0.0);
+      EXPECT_EQ(breaks, 0);
+    } else {
+      // K_unload = 2 k / (1 + d) = 1.333e7 N/m; 2e-8 m of opening per step: 0.27 N per step
+      EXPECT_GT(max_tension, tenf - 0.5);
+      EXPECT_LT(max_tension, tenf + 0.5);
+      EXPECT_EQ(breaks, 1);
+      EXPECT_GT(m.energy().bond_break, 0);
+    }
+  }
+}

@@ -73,11 +73,48 @@ HysteresisContact make(const HysteresisProps& p) {
   c.k_unload = 2 * p.hys_knm / (1 + d);   // Eq. 22
   c.ks = p.hys_ks;
   c.fric = p.hys_fric;
+  c.tenf = p.hys_tenf;
+  c.shearf = p.hys_shearf;
+  if (c.tenf > 0 || c.shearf > 0)
+    c.state = 3;
   return c;
 }
 
 void update(HysteresisContact& c, const ContactKinematics& k, ContactResult& out,
             EventSink& events) noexcept {
+  if (c.state == 3) {
+    // Bonded: the same loading/unloading springs, but tension is carried (opening unloads with
+    // K_unload, continuing into tension) and the shear does not slip; the bond breaks like a
+    // contact bond (thesis 4.4).
+    const double dx = -k.d_dn;
+    const double F0 = c.Fn;
+    const double kk = (dx > 0 && c.Fn <= 0) ? c.k_load : c.k_unload;
+    c.Fn = c.Fn - kk * dx;
+    c.W_normal += -0.5 * (F0 + c.Fn) * dx;
+    c.E_hys = c.W_normal - 0.5 * c.Fn * c.Fn / c.k_unload;
+    linear::shear_update(c.ks, c.fric, c.Fn, c.Fss, c.Fst, c.E_slip, c.slip, k, events, false);
+    const double Fs = std::sqrt(c.Fss * c.Fss + c.Fst * c.Fst);
+    const int mode = c.Fn >= c.tenf && c.tenf > 0 ? 1 : (Fs >= c.shearf && c.shearf > 0 ? 2 : 0);
+    if (mode != 0) {
+      Event e;
+      e.type = EventType::BondBreak;
+      e.mode = mode;
+      e.strength = mode == 1 ? c.tenf : c.shearf;
+      e.energy = energy(c).strain;
+      events.raise(e);
+      c.state = static_cast<std::uint8_t>(mode);
+      if (mode == 1 || c.Fn > 0) {
+        c.Fn = c.Fss = c.Fst = 0;
+      } else if (Fs > -c.fric * c.Fn) {
+        const double scale = -c.fric * c.Fn / Fs;
+        c.Fss *= scale;
+        c.Fst *= scale;
+      }
+      c.E_hys = c.W_normal - 0.5 * c.Fn * c.Fn / c.k_unload;
+    }
+    out = ContactResult{c.Fn, c.Fss, c.Fst, 0, 0, 0};
+    return;
+  }
   if (k.gap > 0) {
     // Separated: no force; a later overlap reloads from wherever it begins (the thesis' drift of
     // the "effective radius" is the model's nature: unloading ends at a residual overlap).

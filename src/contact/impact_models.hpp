@@ -70,6 +70,10 @@ struct HysteresisProps {
   double hys_dampn = 1; ///< K_load / K_unload, (0, 1] [-]
   double hys_ks = 0;    ///< shear stiffness [N/m]
   double hys_fric = 0;  ///< friction coefficient [-]
+  /// Contact-bond option (thesis 4.4 on the hysteretic contact): > 0 bonds the contact when it
+  /// is created; while bonded it carries tension and does not slip [N].
+  double hys_tenf = 0;
+  double hys_shearf = 0;
 };
 
 struct HysteresisContact {
@@ -80,6 +84,8 @@ struct HysteresisContact {
   double E_hys = 0;    ///< dissipated by the hysteresis [J]
   double E_slip = 0;
   bool slip = false;
+  double tenf = 0, shearf = 0; ///< bond strengths [N]
+  std::uint8_t state = 0;      ///< 0 never bonded, 1 broke in tension, 2 in shear, 3 bonded
 };
 
 namespace hysteresis {
@@ -101,8 +107,8 @@ inline ContactEnergy energy(const HysteresisContact& c) {
   e.dashpot = c.E_hys;
   return e;
 }
-inline bool keeps_alive(const HysteresisContact&) {
-  return false;
+inline bool keeps_alive(const HysteresisContact& c) {
+  return c.state == 3;
 }
 
 } // namespace hysteresis

@@ -442,6 +442,8 @@ ModelProps read_model_props(JsonObject& p, const std::string& model, int dim) {
     h.hys_dampn = p.number("hys_dampn", {0, 1, true, false}, 1.0);
     h.hys_ks = p.number("hys_ks", Range::non_negative(), 0.0, "N/m");
     h.hys_fric = p.number("hys_fric", Range::non_negative(), 0.0);
+    h.hys_tenf = p.number("hys_tenf", Range::non_negative(), 0.0, "N");
+    h.hys_shearf = p.number("hys_shearf", Range::non_negative(), 0.0, "N");
     p.finish();
     return h;
   }

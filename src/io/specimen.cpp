@@ -96,14 +96,14 @@ template <class A> void io(A& a, SmoothJointProps& p) {
       a(p.bond_gap_lo), a(p.bond_gap_hi);
 }
 template <class A> void io(A& a, HysteresisProps& p) {
-  a(p.hys_knm), a(p.hys_dampn), a(p.hys_ks), a(p.hys_fric);
+  a(p.hys_knm), a(p.hys_dampn), a(p.hys_ks), a(p.hys_fric), a(p.hys_tenf), a(p.hys_shearf);
 }
 template <class A> void io(A& a, PowerPlasticProps& p) {
   a(p.pp_kn), a(p.pp_ks), a(p.pp_fric), a(p.pp_T), a(p.pp_b);
 }
 template <class A> void io(A& a, HysteresisContact& c) {
   a(c.k_load), a(c.k_unload), a(c.ks), a(c.fric), a(c.Fn), a(c.Fss), a(c.Fst), a(c.W_normal),
-      a(c.E_hys), a(c.E_slip), a(c.slip);
+      a(c.E_hys), a(c.E_slip), a(c.slip), a(c.tenf), a(c.shearf), a(c.state);
 }
 template <class A> void io(A& a, PowerPlasticContact& c) {
   a(c.kn), a(c.ks), a(c.fric), a(c.T), a(c.b), a(c.x_max), a(c.F_max), a(c.x), a(c.Fn), a(c.Fss),
