@@ -141,6 +141,7 @@ nlohmann::json energy_json(const EnergyLedger& e) {
           {"slip", e.slip},
           {"dashpot", e.dashpot},
           {"plastic", e.plastic},
+          {"bond_break", e.bond_break},
           {"initial_total", e.initial_total},
           {"balance_error", e.balance_error()}};
 }

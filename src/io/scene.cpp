@@ -1,5 +1,7 @@
 #include "io/scene.hpp"
 
+#include "io/results.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -540,20 +542,11 @@ void read_history(JsonObject& top, Scene& s) {
   JsonObject h = top.object("history");
   s.history_every = h.integer("every", 1, std::numeric_limits<std::int32_t>::max(), 100);
   const Model& m = *s.model;
-  static const std::vector<std::string> energies{"kinetic",
-                                                 "kinetic_translational",
-                                                 "kinetic_rotational",
-                                                 "strain",
-                                                 "bond_strain",
-                                                 "body_work",
-                                                 "gravity_work",
-                                                 "boundary_work",
-                                                 "local_damping",
-                                                 "slip",
-                                                 "dashpot",
-                                                 "plastic",
-                                                 "bond_break",
-                                                 "balance_error"};
+  // The partitions a column may name: those of results.json's energy record.
+  const nlohmann::json energies = energy_json(EnergyLedger{});
+  auto is_energy = [&](const std::string& q) {
+    return energies.contains(q) && q != "initial_total";
+  };
   for (const auto& [jc, path] : h.array("columns")) {
     if (!jc->is_string())
       throw InputError(top.file() + ": key '" + path + "': expected a column name, got " +
@@ -573,6 +566,18 @@ void read_history(JsonObject& top, Scene& s) {
     }
     HistoryColumn c;
     c.name = name;
+    auto parse_id = [&](const std::string& what) {
+      std::size_t used = 0;
+      std::int64_t id = 0;
+      try {
+        id = std::stoll(parts[1], &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != parts[1].size())
+        bad("has a " + what + " id that is not an integer");
+      return id;
+    };
     auto component = [&](const std::string& comp) {
       static const std::map<std::string, int> comps{{"x", 0}, {"y", 1}, {"z", 2}, {"mag", 3}};
       auto it = comps.find(comp);
@@ -602,19 +607,11 @@ void read_history(JsonObject& top, Scene& s) {
     } else if (parts[0] == "energy" && parts.size() == 2) {
       c.kind = HistoryColumn::Kind::Energy;
       c.quantity = parts[1];
-      if (std::find(energies.begin(), energies.end(), c.quantity) == energies.end())
+      if (!is_energy(c.quantity))
         bad("names an unknown energy partition");
     } else if (parts[0] == "ball" && parts.size() == 4) {
       c.kind = HistoryColumn::Kind::Ball;
-      std::int64_t id = 0;
-      try {
-        std::size_t used = 0;
-        id = std::stoll(parts[1], &used);
-        if (used != parts[1].size())
-          throw std::invalid_argument("id");
-      } catch (const std::exception&) {
-        bad("has a ball id that is not an integer");
-      }
+      const std::int64_t id = parse_id("ball");
       auto it = std::find(m.balls.id.begin(), m.balls.id.end(), id);
       if (it == m.balls.id.end())
         bad("names ball id " + parts[1] + ", which does not exist");
@@ -646,22 +643,13 @@ void read_history(JsonObject& top, Scene& s) {
         bad("names group \"" + parts[1] + "\", which no ball or clump has");
       c.index = static_cast<std::size_t>(it - m.group_names.begin());
       c.quantity = parts[2];
-      if (std::find(energies.begin(), energies.end(), c.quantity) == energies.end() ||
-          c.quantity == "boundary_work" || c.quantity == "balance_error")
+      if (!is_energy(c.quantity) || c.quantity == "boundary_work" || c.quantity == "balance_error")
         bad("names an energy partition that is not traced per group (allowed: kinetic, "
             "kinetic_translational, kinetic_rotational, strain, bond_strain, body_work, "
             "gravity_work, local_damping, slip, dashpot, plastic, bond_break)");
     } else if (parts[0] == "clump" && parts.size() == 4) {
       c.kind = HistoryColumn::Kind::Clump;
-      std::int64_t id = -1;
-      try {
-        std::size_t used = 0;
-        id = std::stoll(parts[1], &used);
-        if (used != parts[1].size())
-          throw std::invalid_argument("id");
-      } catch (const std::exception&) {
-        bad("has a clump id that is not an integer");
-      }
+      const std::int64_t id = parse_id("clump");
       auto it = std::find_if(m.clumps.begin(), m.clumps.end(),
                              [&](const Clump& k) { return k.id == id; });
       if (it == m.clumps.end())
@@ -870,21 +858,7 @@ void EventCounts::add(const std::vector<Event>& events) {
 }
 
 double energy_partition(const EnergyLedger& e, const std::string& name) {
-  const std::map<std::string, double> v{{"kinetic", e.kinetic()},
-                                        {"kinetic_translational", e.kinetic_translational},
-                                        {"kinetic_rotational", e.kinetic_rotational},
-                                        {"strain", e.strain},
-                                        {"bond_strain", e.bond_strain},
-                                        {"body_work", e.body_work},
-                                        {"gravity_work", e.gravity_work},
-                                        {"boundary_work", e.boundary_work},
-                                        {"local_damping", e.local_damping},
-                                        {"slip", e.slip},
-                                        {"dashpot", e.dashpot},
-                                        {"plastic", e.plastic},
-                                        {"bond_break", e.bond_break},
-                                        {"balance_error", e.balance_error()}};
-  return v.at(name);
+  return energy_json(e).at(name).get<double>();
 }
 
 double history_value(const Model& m, const HistoryColumn& c, const EnergyLedger& e,

@@ -96,7 +96,8 @@ std::vector<Pebble> read_clump_pebbles(JsonObject& o, int dim, bool position_req
 /// The properties of one contact model ("linear", "hysteretic", "powerplastic", ...) from the
 /// keys of a contact_models entry (docs/scene-format.md).
 ModelProps read_contact_props(JsonObject& p, const std::string& model, int dim);
-/// One energy partition by name (energy/NAME columns); throws std::out_of_range if unknown.
+/// One energy partition by name (energy/NAME columns): the entries of energy_json (results.hpp);
+/// an unknown name throws.
 double energy_partition(const EnergyLedger& e, const std::string& name);
 
 } // namespace rocklab
