@@ -20,11 +20,10 @@ void CrackMonitor::consume(const Model& m, const std::vector<Event>& events) {
     c.gap = e.gap;
     c.strength = e.strength;
     c.energy = e.energy;
-    const auto end1 = static_cast<std::size_t>(e.contact >> 32);
-    const bool facet = ((e.contact >> 31) & 1u) != 0;
-    const auto end2 = static_cast<std::size_t>(e.contact & 0x7fffffffu);
-    c.ball1 = m.balls.id[end1];
-    c.ball2 = facet ? -1 : m.balls.id[end2];
+    const ContactEnds ends = contact_ends(e.contact);
+    c.ball1 = m.balls.id[static_cast<std::size_t>(ends.end1)];
+    c.ball2 =
+        ends.kind == ContactKind::BallFacet ? -1 : m.balls.id[static_cast<std::size_t>(ends.end2)];
     (c.mode == 1 ? tension_ : shear_) += 1;
     cracks_.push_back(c);
   }

@@ -673,7 +673,6 @@ GenesisResult run_genesis(const MaterialCard& card,
       std::vector<Pebble> pebbles;
       Vec3 vel;
       int group;
-      std::int64_t first_id;
       std::vector<std::int64_t> ids;
     };
     std::vector<Pending> pending;

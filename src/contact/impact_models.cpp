@@ -4,8 +4,43 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace rocklab {
+
+namespace {
+
+// The contact-bond break rule (thesis 4.4), shared by the bonded models: tension at or above
+// `tenf` breaks in tension, else shear at or above `shearf` in shear. A broken bond raises its
+// event (with the strain energy `stored()` gives before the forces change), records the mode in
+// `state`, and leaves no force in tension and the shear cut to the friction limit in
+// compression. Returns true if the bond broke.
+template <class StoredEnergy>
+bool point_bond_break(double tenf, double shearf, double fric, double& Fn, double& Fss, double& Fst,
+                      std::uint8_t& state, EventSink& events, StoredEnergy&& stored) noexcept {
+  const double Fs = std::sqrt(Fss * Fss + Fst * Fst);
+  const int mode = Fn >= tenf ? 1 : (Fs >= shearf ? 2 : 0);
+  if (mode == 0)
+    return false;
+  Event e;
+  e.type = EventType::BondBreak;
+  e.mode = mode;
+  e.strength = mode == 1 ? tenf : shearf;
+  e.energy = stored();
+  e.size = 0; // a point bond
+  events.raise(e);
+  state = static_cast<std::uint8_t>(mode);
+  if (mode == 1 || Fn > 0) {
+    Fn = Fss = Fst = 0;
+  } else if (Fs > -fric * Fn) { // the friction limit takes over
+    const double scale = -fric * Fn / Fs;
+    Fss *= scale;
+    Fst *= scale;
+  }
+  return true;
+}
+
+} // namespace
 
 namespace contactbond {
 
@@ -32,33 +67,8 @@ void update(ContactBondContact& c, const ContactKinematics& k, ContactResult& ou
   // Bonded: the normal spring carries tension too; shear without slip (section 4.4).
   s.Fn = p.kn * (k.gap - p.rgap);
   linear::shear_update(p.ks, p.fric, s.Fn, s.Fss, s.Fst, s.E_slip, s.slip, k, events, false);
-  const double Fs = std::sqrt(s.Fss * s.Fss + s.Fst * s.Fst);
-  int mode = 0;
-  double strength = 0;
-  if (s.Fn >= c.tenf) {
-    mode = 1;
-    strength = c.tenf;
-  } else if (Fs >= c.shearf) {
-    mode = 2;
-    strength = c.shearf;
-  }
-  if (mode != 0) {
-    Event e;
-    e.type = EventType::BondBreak;
-    e.mode = mode;
-    e.strength = strength;
-    e.energy = linear::energy(c.lin).strain;
-    e.size = 0; // a point bond
-    events.raise(e);
-    c.state = static_cast<std::uint8_t>(mode);
-    if (mode == 1 || s.Fn > 0) {
-      s.Fn = s.Fss = s.Fst = 0;
-    } else if (Fs > -p.fric * s.Fn) { // the friction limit takes over
-      const double scale = -p.fric * s.Fn / Fs;
-      s.Fss *= scale;
-      s.Fst *= scale;
-    }
-  }
+  point_bond_break(c.tenf, c.shearf, p.fric, s.Fn, s.Fss, s.Fst, c.state, events,
+                   [&] { return linear::energy(c.lin).strain; });
   out = ContactResult{s.Fn, s.Fss, s.Fst, 0, 0, 0};
 }
 
@@ -93,25 +103,11 @@ void update(HysteresisContact& c, const ContactKinematics& k, ContactResult& out
     c.W_normal += -0.5 * (F0 + c.Fn) * dx;
     c.E_hys = c.W_normal - 0.5 * c.Fn * c.Fn / c.k_unload;
     linear::shear_update(c.ks, c.fric, c.Fn, c.Fss, c.Fst, c.E_slip, c.slip, k, events, false);
-    const double Fs = std::sqrt(c.Fss * c.Fss + c.Fst * c.Fst);
-    const int mode = c.Fn >= c.tenf && c.tenf > 0 ? 1 : (Fs >= c.shearf && c.shearf > 0 ? 2 : 0);
-    if (mode != 0) {
-      Event e;
-      e.type = EventType::BondBreak;
-      e.mode = mode;
-      e.strength = mode == 1 ? c.tenf : c.shearf;
-      e.energy = energy(c).strain;
-      events.raise(e);
-      c.state = static_cast<std::uint8_t>(mode);
-      if (mode == 1 || c.Fn > 0) {
-        c.Fn = c.Fss = c.Fst = 0;
-      } else if (Fs > -c.fric * c.Fn) {
-        const double scale = -c.fric * c.Fn / Fs;
-        c.Fss *= scale;
-        c.Fst *= scale;
-      }
+    // A zero strength means that part of the bond was not given: it never breaks that way.
+    constexpr double never = std::numeric_limits<double>::infinity();
+    if (point_bond_break(c.tenf > 0 ? c.tenf : never, c.shearf > 0 ? c.shearf : never, c.fric, c.Fn,
+                         c.Fss, c.Fst, c.state, events, [&] { return energy(c).strain; }))
       c.E_hys = c.W_normal - 0.5 * c.Fn * c.Fn / c.k_unload;
-    }
     out = ContactResult{c.Fn, c.Fss, c.Fst, 0, 0, 0};
     return;
   }

@@ -16,6 +16,16 @@ inline std::uint64_t contact_key(ContactKind kind, std::int32_t end1, std::int32
          static_cast<std::uint32_t>(end2);
 }
 
+/// The pieces a contact key names (the inverse of contact_key).
+struct ContactEnds {
+  ContactKind kind = ContactKind::BallBall;
+  std::int32_t end1 = -1, end2 = -1; ///< ball indices; end2 is the wall index for a facet
+};
+inline ContactEnds contact_ends(std::uint64_t key) {
+  return {static_cast<ContactKind>((key >> 31) & 1u), static_cast<std::int32_t>(key >> 32),
+          static_cast<std::int32_t>(key & 0x7fffffffu)};
+}
+
 struct Contact {
   std::uint64_t key = 0;
   std::int32_t end1 = -1;  ///< ball index

@@ -498,10 +498,11 @@ void Model::force_displacement(double dt) {
       continue;
     // The released bond energy leaves the stored partitions: book it, shared like the contact.
     ledger_.bond_break += ev.energy;
+    const ContactEnds ends = contact_ends(ev.contact);
     Contact c;
-    c.end1 = static_cast<std::int32_t>(ev.contact >> 32);
-    c.kind = static_cast<ContactKind>((ev.contact >> 31) & 1u);
-    c.end2 = static_cast<std::int32_t>(ev.contact & 0x7fffffffu);
+    c.kind = ends.kind;
+    c.end1 = ends.end1;
+    c.end2 = ends.end2;
     ContactEnergy released;
     released.bond_strain = ev.energy;
     share_contact_energy(c, released, broken_);
