@@ -72,7 +72,7 @@ void BM_LinearDense3D_20k(benchmark::State& state) {
 // The bonded models on the same packing: bonds installed at every contact, strengths high
 // enough that nothing breaks (this measures the elastic cycle).
 void BM_PBondDense3D_20k(benchmark::State& state) {
-  PBondProps p;
+  LinearPBondProps p;
   p.linear.emod = 1e9;
   p.linear.kratio = 1.5;
   p.linear.fric = 0.5;

@@ -1,5 +1,6 @@
 #include "lab/drop_test.hpp"
 
+#include "contact/model_json.hpp"
 #include "core/model.hpp"
 #include "io/json_input.hpp"
 #include "io/output_dir.hpp"
@@ -46,7 +47,7 @@ DropProtocol drop_protocol_from_json(const nlohmann::json& j, const std::string&
         rmin = std::min(rmin, q.radius);
       if (auto* cb = std::get_if<ContactBondProps>(&p.bond))
         cb->bond_gap_hi = std::max(cb->bond_gap_hi, 1e-9 * rmin);
-      if (auto* pb = std::get_if<PBondProps>(&p.bond))
+      if (auto* pb = std::get_if<LinearPBondProps>(&p.bond))
         pb->bond_gap_hi = std::max(pb->bond_gap_hi, 1e-9 * rmin);
       b.finish();
       if (p.rock.size() < 2)
@@ -298,11 +299,7 @@ DropResult run_drop(const DropProtocol& p, double speed, double exponent, std::s
     for (const Contact& k : m.contacts()) {
       if (k.kind != ContactKind::BallBall)
         continue;
-      bool intact = false;
-      if (k.model == ModelKind::ContactBond)
-        intact = m.batches().contactbond[k.slot].state == 3;
-      else if (k.model == ModelKind::PBond)
-        intact = m.batches().pbond[k.slot].s.state == 3;
+      const bool intact = contact_bond_view(m.batches(), k.model, k.slot).intact > 0;
       if (intact)
         parent[root(static_cast<std::size_t>(k.end1))] = root(static_cast<std::size_t>(k.end2));
     }

@@ -462,7 +462,7 @@ GenesisResult run_genesis(const MaterialCard& card,
   say("compacting to the target porosity at the installation pressure");
   auto set_packing_friction = [&](double f) {
     std::get<LinearProps>(m.rules[0].props).fric = f;
-    m.set_property(ModelKind::Linear, "fric", f, ContactSelect::BallBall);
+    m.set_property(model_kind<Linear>, "fric", f, ContactSelect::BallBall);
   };
   auto install_card_stiffness = [&] {
     LinearProps& b = std::get<LinearProps>(m.rules[0].props);
@@ -471,10 +471,10 @@ GenesisResult run_genesis(const MaterialCard& card,
     b.ks = stiff.ks;
     w.kn = 2 * stiff.kn;
     w.ks = 2 * stiff.ks;
-    m.set_property(ModelKind::Linear, "kn", b.kn, ContactSelect::BallBall);
-    m.set_property(ModelKind::Linear, "ks", b.ks, ContactSelect::BallBall);
-    m.set_property(ModelKind::Linear, "kn", w.kn, ContactSelect::BallFacet);
-    m.set_property(ModelKind::Linear, "ks", w.ks, ContactSelect::BallFacet);
+    m.set_property(model_kind<Linear>, "kn", b.kn, ContactSelect::BallBall);
+    m.set_property(model_kind<Linear>, "ks", b.ks, ContactSelect::BallBall);
+    m.set_property(model_kind<Linear>, "kn", w.kn, ContactSelect::BallFacet);
+    m.set_property(model_kind<Linear>, "ks", w.ks, ContactSelect::BallFacet);
   };
   {
     const std::int64_t start = m.step();
@@ -756,7 +756,7 @@ GenesisResult run_genesis(const MaterialCard& card,
       }
       m.replace_contact_model(ci, fj);
     } else if (card.bonding == MaterialCard::Bonding::ParallelBond) {
-      PBondProps pb = card.pb;
+      LinearPBondProps pb = card.pb;
       pb.pb_ten = normal(rng, card.pb_ten);
       pb.pb_coh = normal(rng, card.pb_coh);
       install_bond(ci, pb, rep.pb_bonded);
@@ -826,7 +826,7 @@ GenesisResult run_genesis(const MaterialCard& card,
 
   // Joint sets: contacts straddling a joint plane become smooth joints.
   for (const JointSpec& j : card.joints) {
-    const Vec3 n = joint_normal(dim, j.dip, j.ddir);
+    const Vec3 n = smoothjoint::joint_normal(dim, j.dip, j.ddir);
     const double extent = card.vessel.size.maxCoeff();
     std::vector<double> offsets{0};
     if (j.spacing > 0)
@@ -836,7 +836,7 @@ GenesisResult run_genesis(const MaterialCard& card,
       }
     for (std::size_t ci = 0; ci < m.contacts().size(); ++ci) {
       const Contact& c = m.contacts()[ci];
-      if (c.kind != ContactKind::BallBall || c.model == ModelKind::SmoothJoint)
+      if (c.kind != ContactKind::BallBall || c.model == model_kind<SmoothJoint>)
         continue;
       const Vec3& a = m.balls.pos[static_cast<std::size_t>(c.end1)];
       const Vec3& b = m.balls.pos[static_cast<std::size_t>(c.end2)];
@@ -854,8 +854,8 @@ GenesisResult run_genesis(const MaterialCard& card,
   rep.grains = static_cast<std::int64_t>(m.balls.size());
   rep.contacts = static_cast<std::int64_t>(m.contacts().size());
   for (const Contact& c : m.contacts()) {
-    rep.linear += c.model == ModelKind::Linear;
-    rep.smoothjoint += c.model == ModelKind::SmoothJoint;
+    rep.linear += c.model == model_kind<Linear>;
+    rep.smoothjoint += c.model == model_kind<SmoothJoint>;
   }
   rep.seconds = std::chrono::duration<double>(clock::now() - t0).count();
   return {std::move(out), rep};

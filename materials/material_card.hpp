@@ -68,7 +68,7 @@ struct MaterialCard {
   Distribution fj_ten, fj_coh;
   double frac_bonded = 1, frac_gapped = 0, frac_slit = 0;
   Distribution gapped_gap; ///< g_o of gapped contacts [m]
-  PBondProps pb;
+  LinearPBondProps pb;
   Distribution pb_ten, pb_coh;
   Distribution cb_tenf, cb_shearf; ///< contact-bond strengths [N] (rock-impact thesis 4.3-4.4)
   // release

@@ -152,18 +152,18 @@ TEST(FlatJointBreakage, PartiallyBrokenJointCarriesOnlyCompressionAndFrictionWhe
   // Bend until the two elements on the tension side have broken.
   while (d.breaks() < 2)
     d.step(0, 0, 0, 0, 1e-7);
-  const auto els = d.b.elements(d.b.flatjoint[0]);
+  const auto els = d.b.of<FlatJoint>().pool.of(d.b.of<FlatJoint>().contacts[0]);
   int broken = 0;
   for (const auto& e : els)
-    broken += e.B != 3;
+    broken += e.B != BondState::Bonded;
   EXPECT_EQ(broken, 2);
-  EXPECT_EQ(els[0].B, 1); // element 1 sits at t = +0.75 R, the most stretched
+  EXPECT_EQ(els[0].B, BondState::Tension); // element 1 sits at t = +0.75 R, the most stretched
   // Now close and shear the joint.
   for (int i = 0; i < 200; ++i)
     d.step(-2e-9, 0, 2e-8);
   bool some_slip = false;
   for (const auto& e : els) {
-    if (e.B == 3)
+    if (e.B == BondState::Bonded)
       continue;
     EXPECT_LE(e.Fn, 0.0);
     EXPECT_LE(std::hypot(e.Fss, e.Fst), mu * std::abs(e.Fn) * (1 + 1e-12));
@@ -174,15 +174,15 @@ TEST(FlatJointBreakage, PartiallyBrokenJointCarriesOnlyCompressionAndFrictionWhe
   for (int i = 0; i < 400; ++i)
     d.step(1e-8);
   for (const auto& e : els) {
-    if (e.B != 3) {
+    if (e.B != BondState::Bonded) {
       EXPECT_LE(e.Fn, 0.0);
     }
   }
 }
 
 namespace {
-PBondProps pb_props(double mcf, double ten, double coh, double fa = 0) {
-  PBondProps p;
+LinearPBondProps pb_props(double mcf, double ten, double coh, double fa = 0) {
+  LinearPBondProps p;
   p.linear.kn = 0;
   p.pb_rmul = 0.8;
   p.pb_kn = 2e12;
@@ -269,11 +269,11 @@ TEST(SmoothJoint, SlidesAtTheCoulombLimitWithDilation) {
   const double kn = 1e12 * A, ks = 1e12 * A;
   const double trial = ks * delta * std::sin(th), limit = mu * kn * delta * std::cos(th);
   ASSERT_GT(trial, limit); // tan 30 > 0.3: the joint slides
-  const auto& sj = dil.b.smoothjoint[0];
+  const auto& sj = dil.b.of<SmoothJoint>().contacts[0];
   EXPECT_TRUE(sj.slip);
   EXPECT_TRUE(near_rel(sj.Fs.norm(), limit, 1e-12));
   // Dilation: the compressive normal force grows by (|Fs*| - Fs^mu) / ks * kn tan(psi).
-  const double growth = plain.b.smoothjoint[0].Fn - sj.Fn;
+  const double growth = plain.b.of<SmoothJoint>().contacts[0].Fn - sj.Fn;
   EXPECT_TRUE(near_rel(growth, (trial - limit) / ks * kn * std::tan(psi * kPi / 180), 1e-12));
   // The force lies along the joint, not the contact normal.
   EXPECT_NE(dil.out.Fss, 0.0);
@@ -283,7 +283,7 @@ TEST(SmoothJoint, HoldsBelowTheCoulombLimit) {
   Driver d(sj_props(15, 0.5, 10), 3); // tan 15 = 0.27 < 0.5
   for (int i = 0; i < 100; ++i)
     d.step(-1e-9);
-  const auto& sj = d.b.smoothjoint[0];
+  const auto& sj = d.b.of<SmoothJoint>().contacts[0];
   EXPECT_FALSE(sj.slip);
   EXPECT_TRUE(near_rel(sj.Fs.norm() / -sj.Fn, std::tan(15 * kPi / 180), 1e-9));
   EXPECT_EQ(d.energy().slip, 0.0);
@@ -295,24 +295,24 @@ TEST(SmoothJoint, BondedJointHoldsUntilItBreaksThenSlides) {
   p.sj_ten = 1e7;
   p.bond = true;
   Driver d(p, 3);
-  EXPECT_EQ(d.b.smoothjoint[0].state, 3);
+  EXPECT_EQ(d.b.of<SmoothJoint>().contacts[0].state, BondState::Bonded);
   const double A = kPi * std::pow(6.25e-3, 2);
   int steps = 0;
   while (d.breaks() == 0 && steps < 100000) {
     d.step(-1e-10);
     ++steps;
     if (d.breaks() == 0) {
-      EXPECT_FALSE(d.b.smoothjoint[0].slip);
+      EXPECT_FALSE(d.b.of<SmoothJoint>().contacts[0].slip);
     }
   }
   EXPECT_EQ(d.breaks(2), 1);
-  const auto& sj = d.b.smoothjoint[0];
+  const auto& sj = d.b.of<SmoothJoint>().contacts[0];
   const double tau_c = 2e6; // phi = 0
   // Broken in shear under compression: the shear force is limited by friction.
   EXPECT_TRUE(near_rel(sj.Fs.norm(), -0.3 * sj.Fn, 1e-12));
   EXPECT_GT(tau_c * A, 0.0);
   d.step(-1e-10);
-  EXPECT_TRUE(d.b.smoothjoint[0].slip);
+  EXPECT_TRUE(d.b.of<SmoothJoint>().contacts[0].slip);
 }
 
 TEST(SmoothJoint, ResistsNoRelativeRotation) {
@@ -390,7 +390,7 @@ TEST(ContactEnergy, SlipEnergyEqualsFrictionWork) {
   Driver fj(fp, 3);
   SmoothJointProps sp = sj_props(0, 0.6, 0); // joint normal along the contact normal
   Driver sj(sp, 3);
-  PBondProps pp = pb_props(1, 0, 0);
+  LinearPBondProps pp = pb_props(1, 0, 0);
   pp.bond = false;
   pp.linear.kn = 1e8;
   pp.linear.ks = 5e7;
@@ -419,7 +419,7 @@ Slide slide(const std::string& name, const Eigen::Matrix3d& R = Eigen::Matrix3d:
   test::transform_model(*s.model, R, Vec3::Zero());
   // The joint plane turns with the scene.
   auto& sj = std::get<SmoothJointProps>(s.model->rules[0].props);
-  const Vec3 nj = R * joint_normal(3, sj.dip, sj.ddir);
+  const Vec3 nj = R * smoothjoint::joint_normal(3, sj.dip, sj.ddir);
   sj.use_normal = true;
   sj.normal = nj;
   Model& m = *s.model;
@@ -483,12 +483,13 @@ TEST(SmoothJoint, InheritsSurfacePropertiesInSeries) {
   Scene s = load_scene(file.string());
   s.model->initialize();
   const ModelBatches& b = s.model->batches();
-  ASSERT_EQ(b.smoothjoint.size(), 1u);                        // balls 1 (a) and 2 (b)
-  EXPECT_TRUE(near_rel(b.smoothjoint[0].kn, 1e12, 1e-15));    // 2e12 and 2e12 in series
-  EXPECT_TRUE(near_rel(b.smoothjoint[0].ks, 0.75e12, 1e-15)); // 1e12 and 3e12 in series
-  EXPECT_EQ(b.smoothjoint[0].fric, 0.4);
-  ASSERT_EQ(b.linear.size(), 1u); // balls 1 and 3 (a, a)
-  EXPECT_TRUE(near_rel(b.linear[0].p.kn, 0.5e6, 1e-15));
-  EXPECT_EQ(b.linear[0].p.fric, 0.2);
-  EXPECT_EQ(b.linear[0].p.ks, 0.0); // not held by the groups: the rule value stays
+  ASSERT_EQ(b.of<SmoothJoint>().contacts.size(), 1u);                     // balls 1 (a) and 2 (b)
+  EXPECT_TRUE(near_rel(b.of<SmoothJoint>().contacts[0].kn, 1e12, 1e-15)); // 2e12 and 2e12 in series
+  EXPECT_TRUE(
+      near_rel(b.of<SmoothJoint>().contacts[0].ks, 0.75e12, 1e-15)); // 1e12 and 3e12 in series
+  EXPECT_EQ(b.of<SmoothJoint>().contacts[0].fric, 0.4);
+  ASSERT_EQ(b.of<Linear>().contacts.size(), 1u); // balls 1 and 3 (a, a)
+  EXPECT_TRUE(near_rel(b.of<Linear>().contacts[0].p.kn, 0.5e6, 1e-15));
+  EXPECT_EQ(b.of<Linear>().contacts[0].p.fric, 0.2);
+  EXPECT_EQ(b.of<Linear>().contacts[0].p.ks, 0.0); // not held by the groups: the rule value stays
 }

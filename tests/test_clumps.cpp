@@ -148,7 +148,7 @@ TEST(Clumps, GroupEnergiesSumToTheModelInATwoClumpRockfall) {
     slope.facets.push_back(f);
   }
   m.walls.push_back(slope);
-  PBondProps pb;
+  LinearPBondProps pb;
   pb.linear = linear_props(1e8, 5e7, 0.5);
   pb.pb_kn = 1e9;
   pb.pb_ks = 5e8;

@@ -72,7 +72,7 @@ TEST(Genesis, PorosityStressAndReleaseForEveryShape) {
       EXPECT_NEAR(r.fj_gapped / n, c.frac_gapped, 1.0 / n + 1e-12) << name;
       EXPECT_NEAR(r.fj_slit / n, c.frac_slit, 1.0 / n + 1e-12) << name;
       std::int64_t bonded = 0;
-      for (const auto& fj : g.model->batches().flatjoint)
+      for (const auto& fj : g.model->batches().of<FlatJoint>().contacts)
         bonded += fj.mtype == 1;
       EXPECT_EQ(bonded, r.fj_bonded) << name;
     } else if (c.bonding == MaterialCard::Bonding::ContactBond) {
@@ -80,13 +80,13 @@ TEST(Genesis, PorosityStressAndReleaseForEveryShape) {
       EXPECT_EQ(r.pb_bonded, 0) << name;
       std::int64_t bonded = 0;
       double tenf = 0;
-      for (const auto& cb : g.model->batches().contactbond) {
-        bonded += cb.state == 3;
-        tenf += cb.state == 3 ? cb.tenf : 0;
+      for (const auto& cb : g.model->batches().of<ContactBond>().contacts) {
+        bonded += cb.state == BondState::Bonded;
+        tenf += cb.state == BondState::Bonded ? cb.tenf : 0;
       }
       int st[4] = {0, 0, 0, 0};
-      for (const auto& cb : g.model->batches().contactbond)
-        ++st[cb.state];
+      for (const auto& cb : g.model->batches().of<ContactBond>().contacts)
+        ++st[static_cast<int>(cb.state)];
       // Every installed bond is still there or broke while the vessel was released (a few).
       EXPECT_EQ(bonded + st[1] + st[2], r.cb_bonded) << name;
       EXPECT_LE(st[1] + st[2], r.cb_bonded / 100) << name;
@@ -94,8 +94,8 @@ TEST(Genesis, PorosityStressAndReleaseForEveryShape) {
     } else {
       EXPECT_GT(r.pb_bonded, 0) << name;
       std::int64_t bonded = 0;
-      for (const auto& pb : g.model->batches().pbond)
-        bonded += pb.s.state == 3;
+      for (const auto& pb : g.model->batches().of<LinearPBond>().contacts)
+        bonded += pb.s.state == BondState::Bonded;
       EXPECT_EQ(bonded, r.pb_bonded) << name;
     }
   }
@@ -116,9 +116,9 @@ TEST(Genesis, CylinderWithRockStiffness) {
   const Model& m = *g.model;
   std::size_t checked = 0;
   for (const Contact& ct : m.contacts()) {
-    if (ct.model != ModelKind::FlatJoint)
+    if (ct.model != model_kind<FlatJoint>)
       continue;
-    const FlatJointContact& fj = m.batches().flatjoint[ct.slot];
+    const FlatJointContact& fj = m.batches().of<FlatJoint>().contacts[ct.slot];
     const double L = m.balls.radius[static_cast<std::size_t>(ct.end1)] +
                      m.balls.radius[static_cast<std::size_t>(ct.end2)];
     EXPECT_TRUE(near_rel(fj.kn, c.fj.fj_emod / L, 1e-12));
@@ -139,7 +139,7 @@ TEST(Genesis, TypeFractionsOnAThreeThousandGrainSpecimen) {
   EXPECT_NEAR(r.fj_slit / n, 0.1, 0.02);
   // The model holds the same types; gapped contacts have their initial gap, the others none.
   std::int64_t count[5] = {0, 0, 0, 0, 0};
-  for (const auto& fj : g.model->batches().flatjoint) {
+  for (const auto& fj : g.model->batches().of<FlatJoint>().contacts) {
     ++count[fj.mtype];
     if (fj.mtype == 2)
       EXPECT_GT(fj.gap0, 0.0);
@@ -171,7 +171,7 @@ TEST(Genesis, JointPlaneBecomesSmoothJoints) {
   ASSERT_EQ(c.joints.size(), 1u);
   const GenesisResult g = run_genesis(c);
   const Model& m = *g.model;
-  const Vec3 n = joint_normal(2, 30, 0);
+  const Vec3 n = smoothjoint::joint_normal(2, 30, 0);
   const Vec3 p0(0.001, 0.002, 0);
   std::int64_t straddling = 0;
   for (const Contact& ct : m.contacts()) {
@@ -181,7 +181,7 @@ TEST(Genesis, JointPlaneBecomesSmoothJoints) {
     const double db = (m.balls.pos[static_cast<std::size_t>(ct.end2)] - p0).dot(n);
     const bool across = (da < 0) != (db < 0);
     straddling += across;
-    EXPECT_EQ(across, ct.model == ModelKind::SmoothJoint);
+    EXPECT_EQ(across, ct.model == model_kind<SmoothJoint>);
   }
   EXPECT_GT(straddling, 10);
   EXPECT_EQ(g.report.smoothjoint, straddling);

@@ -106,7 +106,7 @@ TEST(ImpactModels, TriangularLimitsAreOneAndRootHalf) {
 TEST(ImpactModels, HysteresisRestitutionIsRootOfStiffnessRatio) {
   for (double d : {0.1, 0.25, 0.5, 0.8, 1.0})
     for (double v : {1.0, 10.0}) {
-      HysteresisProps h;
+      HystereticProps h;
       h.hys_knm = 6.4e7;
       h.hys_dampn = d;
       h.hys_ks = 9.6e6;
@@ -120,7 +120,7 @@ TEST(ImpactModels, HysteresisRestitutionIsRootOfStiffnessRatio) {
 TEST(ImpactModels, StiffContactsStayStableAtTheAutomaticTimeStep) {
   // The thesis' blow-up case: a stiff contact (6.4e10 N/m) hit fast. The rebound may never be
   // faster than the impact.
-  HysteresisProps h;
+  HystereticProps h;
   h.hys_knm = 6.4e10;
   h.hys_dampn = 0.3;
   for (double safety : {0.08, 0.8})
@@ -221,7 +221,7 @@ TEST(ImpactModels, HystereticBondCarriesTensionUntilItsStrength) {
       m.balls.fixity[i] = 0x3f;
     m.balls.vel[a] = Vec3(-0.1, 0, 0);
     m.balls.vel[b] = Vec3(0.1, 0, 0);
-    HysteresisProps h;
+    HystereticProps h;
     h.hys_knm = 1e7;
     h.hys_dampn = 0.5;
     h.hys_ks = 5e6;

@@ -34,17 +34,17 @@ Interlocked run(const std::string& name, const Eigen::Matrix3d& R = Eigen::Matri
   };
   auto max_fn = [&]() {
     double f = 0;
-    for (const auto& fj : m.batches().flatjoint)
-      for (const auto& e : m.batches().elements(fj))
+    for (const auto& fj : m.batches().of<FlatJoint>().contacts)
+      for (const auto& e : m.batches().of<FlatJoint>().pool.of(fj))
         f = std::max(f, std::abs(e.Fn));
     return f;
   };
   Interlocked out;
   apply(s.stages[0]);
   m.cycle(s.stages[0].run.cycles);
-  for (const auto& fj : m.batches().flatjoint) {
+  for (const auto& fj : m.batches().of<FlatJoint>().contacts) {
     std::vector<double> fn;
-    for (const auto& e : m.batches().elements(fj))
+    for (const auto& e : m.batches().of<FlatJoint>().pool.of(fj))
       fn.push_back(e.Fn);
     out.element_fn.push_back(fn);
   }

@@ -190,7 +190,7 @@ Slide incline(double theta, double mu, double run_time) {
   int steps = static_cast<int>(run_time / m.settings.timestep);
   m.cycle(steps);
   const EnergyLedger e = m.energy();
-  const auto& lc = m.batches().linear.at(0);
+  const auto& lc = m.batches().of<Linear>().contacts.at(0);
   return {(m.balls.pos[b] - x0).dot(down_slope),
           e.slip,
           0.5 * (lc.s.Fss * lc.s.Fss + lc.s.Fst * lc.s.Fst) / p.ks,

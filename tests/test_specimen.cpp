@@ -26,7 +26,7 @@ std::unique_ptr<Model> busy_model() {
   fj.fj_ten = fj.fj_coh = 2e3;
   fj.fj_fric = 0.4;
   fj.bond = true;
-  PBondProps pb;
+  LinearPBondProps pb;
   pb.linear.kn = 2e4;
   pb.linear.ks = 1e4;
   pb.linear.fric = 0.5;
@@ -62,9 +62,9 @@ std::unique_ptr<Model> busy_model() {
 
 TEST(Specimen, RoundTripContinuesBitForBit) {
   std::unique_ptr<Model> a = busy_model();
-  ASSERT_GT(a->batches().flatjoint.size(), 0u);
-  ASSERT_GT(a->batches().pbond.size(), 0u);
-  ASSERT_GT(a->batches().smoothjoint.size(), 0u);
+  ASSERT_GT(a->batches().of<FlatJoint>().contacts.size(), 0u);
+  ASSERT_GT(a->batches().of<LinearPBond>().contacts.size(), 0u);
+  ASSERT_GT(a->batches().of<SmoothJoint>().contacts.size(), 0u);
   const fs::path file = rocklab::test::scratch_root() / "rocklab-roundtrip.rlspec";
   save_model(*a, file.string(), {{"note", "test"}});
   nlohmann::json meta;

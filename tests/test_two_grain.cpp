@@ -166,12 +166,12 @@ TEST(ContactMethods, UnbondThenBondAgainInStages) {
       EXPECT_EQ(m.apply_method(mc.model, mc.method, mc.gap_lo, mc.gap_hi, mc.element), 1u);
     if (k == 1) {
       m.cycle(1);
-      EXPECT_EQ(m.batches().pbond[0].s.state, 0);
+      EXPECT_EQ(m.batches().of<LinearPBond>().contacts[0].s.state, BondState::None);
       EXPECT_EQ(local_components(m.contacts()[0], m.contact_outputs()[0]).Fn, 0.0);
     } else {
       m.cycle(s.stages[k].run.cycles);
       // Bonded again at a 0.501 mm gap: the new bond carries only the last 0.5 mm.
-      EXPECT_EQ(m.batches().pbond[0].s.state, 3);
+      EXPECT_EQ(m.batches().of<LinearPBond>().contacts[0].s.state, BondState::Bonded);
       EXPECT_TRUE(near_rel(local_components(m.contacts()[0], m.contact_outputs()[0]).Fn,
                            axial(3) / 2, 1e-9));
     }

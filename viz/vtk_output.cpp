@@ -82,42 +82,17 @@ Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, doubl
   if (reference.size() == b.size())
     for (std::size_t i = 0; i < b.size(); ++i)
       s.disp[i] = b.pos[i] - reference[i];
-  const ModelBatches& bt = m.batches();
   for (const Contact& c : m.contacts()) {
     if (c.kind != ContactKind::BallBall)
       continue;
-    int model = 0, state = 0;
-    double broken = 0;
-    if (c.model == ModelKind::PBond) {
-      const PBondContact& pb = bt.pbond[c.slot];
-      model = 1;
-      if (pb.s.state == 0)
-        continue; // never bonded
-      state = pb.s.state == 3 ? 2 : 0;
-      broken = pb.s.state == 3 ? 0.0 : 1.0;
-    } else if (c.model == ModelKind::FlatJoint) {
-      const FlatJointContact& fj = bt.flatjoint[c.slot];
-      model = 2;
-      int bonded = 0, gone = 0;
-      for (const FlatJointElement& e : bt.elements(fj)) {
-        bonded += e.B == 3;
-        gone += e.B == 1 || e.B == 2;
-      }
-      if (bonded + gone == 0)
-        continue; // a gapped or slit joint: no bond to draw
-      state = bonded == 0 ? 0 : (gone == 0 ? 2 : 1);
-      broken = static_cast<double>(gone) / static_cast<double>(fj.n_elem);
-    } else if (c.model == ModelKind::SmoothJoint) {
-      model = 3;
-      state = bt.smoothjoint[c.slot].state == 3 ? 2 : 0;
-    } else {
-      continue;
-    }
+    const BondView v = contact_bond_view(m.batches(), c.model, c.slot);
+    if (v.parts == 0)
+      continue; // no bond: never bonded, or a gapped or slit flat joint
     s.bond_ends.push_back(
         {b.pos[static_cast<std::size_t>(c.end1)], b.pos[static_cast<std::size_t>(c.end2)]});
-    s.bond_model.push_back(model);
-    s.bond_state.push_back(state);
-    s.broken_fraction.push_back(broken);
+    s.bond_model.push_back(static_cast<std::int32_t>(c.model));
+    s.bond_state.push_back(v.intact == 0 ? 0 : (v.broken == 0 ? 2 : 1));
+    s.broken_fraction.push_back(static_cast<double>(v.broken) / static_cast<double>(v.parts));
   }
   s.walls = m.walls;
   double lo = 1e300, hi = -1e300;

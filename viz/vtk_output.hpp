@@ -34,11 +34,13 @@ struct Snapshot {
   std::vector<double> radius;       ///< [m]
   std::vector<std::int32_t> group;
   std::vector<std::int64_t> id;
-  // bonded contacts (parallel bonds and flat joints)
+  // bonded contacts: every contact whose model has a bond (BondView), and smooth joints
   std::vector<std::array<Vec3, 2>> bond_ends; ///< the two grain centres [m]
-  std::vector<std::int32_t> bond_model;       ///< 1 linearpbond, 2 flatjoint, 3 smoothjoint
-  std::vector<std::int32_t> bond_state;       ///< 0 no bonded part left, 1 partly, 2 intact
-  std::vector<double> broken_fraction;        ///< broken elements / elements (pbond: 0 or 1)
+  /// the contact model's index in the registry (1 linearpbond, 2 flatjoint, 3 smoothjoint,
+  /// 4 hysteretic, 6 contactbond)
+  std::vector<std::int32_t> bond_model;
+  std::vector<std::int32_t> bond_state; ///< 0 no bonded part left, 1 partly, 2 intact
+  std::vector<double> broken_fraction;  ///< broken parts / parts (flat joints: elements)
   // walls (platens, confinement)
   std::vector<Wall> walls;
   double wall_extent = 1; ///< drawn length of unbounded cylinder walls [m]

@@ -1,4 +1,5 @@
 // rocklab command-line interface. All quantities in input and output files are SI.
+#include "contact/model_json.hpp"
 #include "io/output_dir.hpp"
 #include "io/scene.hpp"
 #include "io/scene_run.hpp"
@@ -344,9 +345,14 @@ int main(int argc, char** argv) {
     if (*test)
       return test_command(protocol_file, test_out, quiet, checkpoint_every, resume);
     if (*info) {
-      std::printf("rocklab %s\nthreads %d\ncontact models: linear, linearpbond, flatjoint, "
-                  "smoothjoint, hysteretic, powerplastic, contactbond\nunits: SI\n",
-                  ROCKLAB_VERSION, omp_get_max_threads());
+      std::string models;
+      for (const std::string& name : rocklab::model_names()) {
+        if (!models.empty())
+          models += ", ";
+        models += name;
+      }
+      std::printf("rocklab %s\nthreads %d\ncontact models: %s\nunits: SI\n", ROCKLAB_VERSION,
+                  omp_get_max_threads(), models.c_str());
       return 0;
     }
   } catch (const rocklab::InputError& e) {

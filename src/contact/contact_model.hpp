@@ -1,12 +1,43 @@
 // Interface between the engine and contact models. A contact model is plain data (properties and
 // per-contact state) plus pure functions; the engine hands it the kinematics of the step, the model
 // returns force and moment in contact-plane coordinates. No I/O, no access to the model.
+//
+// Each model file declares one traits type (e.g. `struct Linear`) with static members, and
+// contact/registry.hpp lists every traits type once (`AllModels`); everything that handles "every
+// model" iterates that list. What a traits type M provides (docs/architecture.md, "Add a contact
+// model"):
+//   name                       the JSON keyword ("linear")
+//   Props, Contact             what a scene assigns, and the per-contact parameters + state
+//   make(props, info)          a new contact (models with a Pool: make(props, info, pool))
+//   update(c, k, out, events)  the force-displacement law (noexcept, pure)
+//   stiffness(c), energy(c), keeps_alive(c)
+//   read(JsonObject&, dim)     its properties from a contact_models entry (units in the doc)
+//   state_json(c, dim)         its state in results.json
+//   io(archive, props), io(archive, contact)   specimen and checkpoint files
+//   property(c, name)          a settable property (PFC's `contact property`), or nullptr
+// and optionally:
+//   bond_view(c)               its bond as output shows it (bonded models)
+//   inherit(props, a, b)       property inheritance from the pieces' groups
+//   methods, call(c, args)     methods called on existing contacts ("bond", "unbond", ...)
+//   ball_facet = false         a model for ball-ball contacts only
+//   Pool                       per-batch storage shared by the contacts (flat-joint elements);
+//                              the functions then take (c, the contact's part of the pool)
 #pragma once
 
 #include "core/events.hpp"
 #include "core/types.hpp"
 
+#include <nlohmann/json_fwd.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string_view>
+
 namespace rocklab {
+
+class JsonObject;
 
 /// Kinematic input of one force-displacement update, in contact-plane coordinates
 /// (FJ memo Eq. 2 and 11). 2D: d_dss = d_tt = d_tbt = 0 and d_tbs = -d_theta_z.
@@ -81,6 +112,76 @@ struct EventSink {
     e.element = element;
     raise(e);
   }
+};
+
+/// State of one bond (a parallel bond, a contact bond, a flat-joint element, a smooth joint),
+/// stored as one byte: never bonded (or unbonded by a method), broken in tension, broken in shear,
+/// intact. The broken codes equal the bond_break event's mode.
+enum class BondState : std::uint8_t { None = 0, Tension = 1, Shear = 2, Bonded = 3 };
+
+inline BondState broken_state(int mode) {
+  return mode == 1 ? BondState::Tension : BondState::Shear;
+}
+
+/// A contact's bond as output shows it: its bondable parts (flat-joint elements; one for the other
+/// bonded models) and how many of them are intact or broken. parts == 0: nothing to draw.
+struct BondView {
+  int parts = 0;
+  int intact = 0;
+  int broken = 0;
+};
+
+/// The view of a model with one bond per contact: nothing to draw if it was never bonded.
+inline BondView point_bond_view(BondState s) {
+  if (s == BondState::None)
+    return {};
+  const bool intact = s == BondState::Bonded;
+  return {1, intact ? 1 : 0, intact ? 0 : 1};
+}
+
+/// Geometry a model may need when a contact is created.
+struct CreationInfo {
+  int dim = 3;
+  double R1 = 0, R2 = 0; ///< piece radii (R2 = 0 for a facet) [m]
+  bool ball_facet = false;
+  double gap = 0;         ///< contact gap at creation [m]
+  Vec3 n = Vec3::UnitX(); ///< contact normal at creation
+};
+
+/// Surface properties of the pieces of one group, inherited by contacts whose rule asks for it.
+/// NaN: the group does not hold the property.
+struct SurfaceProps {
+  double kn = std::numeric_limits<double>::quiet_NaN();      ///< [N/m]
+  double ks = std::numeric_limits<double>::quiet_NaN();      ///< [N/m]
+  double fric = std::numeric_limits<double>::quiet_NaN();    ///< [-]
+  double sj_kn = std::numeric_limits<double>::quiet_NaN();   ///< [Pa/m]
+  double sj_ks = std::numeric_limits<double>::quiet_NaN();   ///< [Pa/m]
+  double sj_fric = std::numeric_limits<double>::quiet_NaN(); ///< [-]
+};
+
+/// Property inheritance (smooth-joint Eq. 18-19; the linear properties inherit the same way): the
+/// two pieces' stiffnesses act in series and the friction is the smaller one. A property is
+/// inherited only when both pieces hold it.
+inline void inherit_series(double& k, double k1, double k2) {
+  if (!std::isnan(k1) && !std::isnan(k2))
+    k = (k1 > 0 && k2 > 0) ? 1.0 / (1.0 / k1 + 1.0 / k2) : 0.0; // Eq. 18
+}
+inline void inherit_minimum(double& mu, double m1, double m2) {
+  if (!std::isnan(m1) && !std::isnan(m2))
+    mu = std::min(m1, m2); // Eq. 19
+}
+
+/// The `bond` key of a bonded model's properties: true/false, a maximum gap [m], or
+/// {"gap": [lo, hi]}; absent: `default_bond` with the gap range (-inf, 0] (model_json.cpp).
+void read_bond_option(JsonObject& p, bool default_bond, bool& bond, double& lo, double& hi);
+
+/// A method called on existing contacts of one model (scene `methods`).
+struct MethodArgs {
+  std::string_view name;              ///< "bond", "unbond", "sj_setforce"
+  double gap_lo = -1e300, gap_hi = 0; ///< act where the contact gap is in [lo, hi] [m]
+  int element = 0;                    ///< flat joints: element 1..N, 0 all
+  double gap = 0;                     ///< this contact's gap [m]
+  Vec3 force = Vec3::Zero();          ///< this contact's force on piece 2 [N]
 };
 
 } // namespace rocklab

@@ -1,5 +1,7 @@
 #include "contact/flat_joint.hpp"
 
+#include "io/json_input.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,6 +9,8 @@
 #include <memory>
 #include <mutex>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 
 namespace rocklab {
 
@@ -275,9 +279,16 @@ void element_2d(double kn, double rbar, double ga, double gb, bool bonded, doubl
   }
 }
 
-FlatJointContact make(const FlatJointProps& p, int dim, double R1, double R2, bool ball_facet,
-                      std::vector<FlatJointElement>& elements) {
-  FlatJointContact c;
+} // namespace flatjoint
+
+using flatjoint::bond;
+
+FlatJoint::Contact FlatJoint::make(const Props& p, const CreationInfo& ci, Pool& pool) {
+  const int dim = ci.dim;
+  const double R1 = ci.R1, R2 = ci.R2;
+  const bool ball_facet = ci.ball_facet;
+  std::vector<FlatJointElement>& elements = pool.all;
+  Contact c;
   c.geo = &flat_joint_geometry(dim, p.fj_Nr, p.fj_Nal);
   c.kn = p.fj_kn;
   c.ks = p.fj_ks;
@@ -305,23 +316,28 @@ FlatJointContact make(const FlatJointProps& p, int dim, double R1, double R2, bo
   return c;
 }
 
+namespace flatjoint {
+
 void bond(FlatJointContact& c, std::span<FlatJointElement> e, std::size_t first) {
   // Only elements with a zero gap over their whole surface can be bonded.
   const double tb = std::hypot(c.tbs, c.tbt);
   for (std::size_t i = 0; i < e.size(); ++i) {
     const double s = c.geo->s[first + i] * c.R, t = c.geo->t[first + i] * c.R;
     if (gap_at(c, s, t) == 0 && tb == 0)
-      e[i].B = 3;
+      e[i].B = BondState::Bonded;
   }
 }
 
 void unbond(FlatJointContact&, std::span<FlatJointElement> e) {
   for (auto& el : e)
-    el.B = 0;
+    el.B = BondState::None;
 }
 
-void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKinematics& k,
-            ContactResult& out, EventSink& events) noexcept {
+} // namespace flatjoint
+
+void FlatJoint::update(Contact& c, Elements e, const ContactKinematics& k, ContactResult& out,
+                       EventSink& events) noexcept {
+  using namespace flatjoint;
   const int dim = k.dim;
   const FlatJointGeometry& geo = *c.geo;
   if (!c.fixed) { // Eq. 30-31, at the first cycle after installation
@@ -341,7 +357,7 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
   // Activity (section 1.6): any element bonded, or the gap negative somewhere.
   bool any_bonded = false;
   for (const auto& el : e)
-    any_bonded = any_bonded || el.B == 3;
+    any_bonded = any_bonded || el.B == BondState::Bonded;
   const double min_gap = c.gs - R * std::hypot(c.tbs, c.tbt);
   if (!any_bonded && min_gap >= 0) {
     for (auto& el : e) {
@@ -393,7 +409,7 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
       }
     };
 
-    const bool bonded = el.B == 3;
+    const bool bonded = el.B == BondState::Bonded;
     normal_update(bonded);
     const double sigma = el.Fn / A; // Eq. 27
     bool do_shear = true;
@@ -417,7 +433,7 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
     };
     if (bonded && sigma > c.ten) { // tensile break
       const double energy = element_strain_energy(c, el, i, A, dim);
-      el.B = 1;
+      el.B = BondState::Tension;
       el.Fn = el.Fss = el.Fst = el.Mt = 0;
       raise_break(1, c.ten, energy);
       do_shear = false;
@@ -466,7 +482,7 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
       const double tau_c = c.coh - sigma * c.tan_fa;
       if (tau > tau_c) { // shear break
         const double energy = element_strain_energy(c, el, i, A, dim);
-        el.B = 2;
+        el.B = BondState::Shear;
         el.Fss = el.Fst = el.Mt = 0;
         normal_update(false); // re-evaluate as unbonded
         raise_break(2, tau_c, energy);
@@ -494,7 +510,7 @@ void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKin
     out.Mt = out.Mbt = out.Fss = 0;
 }
 
-ContactStiffness stiffness(const FlatJointContact& c) {
+ContactStiffness FlatJoint::stiffness(const Contact& c) {
   // Eq. 41-42
   const double R = c.R;
   const int dim = c.geo->dim;
@@ -504,7 +520,7 @@ ContactStiffness stiffness(const FlatJointContact& c) {
   return {(c.kn + c.ks) * A, c.ks * A, c.kn * I + c.ks * J};
 }
 
-ContactEnergy energy(const FlatJointContact& c, std::span<const FlatJointElement> e) {
+ContactEnergy FlatJoint::energy(const Contact& c, ConstElements e) {
   ContactEnergy out;
   const int dim = c.geo->dim;
   for (std::size_t i = 0; i < e.size(); ++i) {
@@ -515,12 +531,99 @@ ContactEnergy energy(const FlatJointContact& c, std::span<const FlatJointElement
   return out;
 }
 
-bool keeps_alive(const FlatJointContact& c, std::span<const FlatJointElement> e) {
+bool FlatJoint::keeps_alive(const Contact& c, ConstElements e) {
   for (const auto& el : e)
-    if (el.B == 3)
+    if (el.B == BondState::Bonded)
       return true;
   return std::sqrt(c.gs * c.gs + c.dss * c.dss + c.dst * c.dst) <= 2 * c.R;
 }
 
-} // namespace flatjoint
+BondView FlatJoint::bond_view(const Contact& c, ConstElements e) {
+  BondView v;
+  for (const FlatJointElement& el : e) {
+    v.intact += el.B == BondState::Bonded;
+    v.broken += el.B == BondState::Tension || el.B == BondState::Shear;
+  }
+  if (v.intact + v.broken > 0) // a gapped or slit joint has no bond to draw
+    v.parts = c.n_elem;
+  return v;
+}
+
+void FlatJoint::call(Contact& c, Elements e, const MethodArgs& m) {
+  if (m.element > static_cast<int>(e.size()))
+    throw std::invalid_argument("flat-joint method '" + std::string(m.name) + "': element " +
+                                std::to_string(m.element) + " is out of range [1, " +
+                                std::to_string(e.size()) + "]");
+  const auto part = m.element > 0 ? e.subspan(static_cast<std::size_t>(m.element - 1), 1) : e;
+  const std::size_t first = m.element > 0 ? static_cast<std::size_t>(m.element - 1) : 0;
+  if (m.name == "bond")
+    flatjoint::bond(c, part, first);
+  else
+    flatjoint::unbond(c, part);
+}
+
+FlatJoint::Props FlatJoint::read(JsonObject& p, int dim) {
+  Props fj;
+  fj.fj_Nr = static_cast<int>(p.integer("fj_Nr", 1, 1000, 2));
+  fj.fj_Nal = static_cast<int>(p.integer("fj_Nal", 3, 1000, 4));
+  if (dim == 2 && p.has("fj_Nal"))
+    p.fail("fj_Nal", "is a 3D property (2D flat joints have fj_Nr elements only)");
+  fj.fj_rmul = p.number("fj_rmul", Range::positive(), 1.0);
+  fj.fj_gap0 = p.number("fj_gap0", Range::non_negative(), 0.0, "m");
+  const bool deform = p.has("fj_emod");
+  if (deform && (p.has("fj_kn") || p.has("fj_ks")))
+    p.fail("fj_emod", "give either fj_kn/fj_ks or fj_emod/fj_kratio, not both");
+  if (deform) {
+    fj.fj_emod = p.number("fj_emod", Range::positive(), std::nullopt, "Pa");
+    fj.fj_kratio = p.number("fj_kratio", Range::non_negative(), 0.0);
+  } else {
+    fj.fj_kn = p.number("fj_kn", Range::non_negative(), 0.0, "Pa/m");
+    fj.fj_ks = p.number("fj_ks", Range::non_negative(), 0.0, "Pa/m");
+  }
+  fj.fj_fric = p.number("fj_fric", Range::non_negative(), 0.0);
+  fj.fj_ten = p.number("fj_ten", Range::non_negative(), 0.0, "Pa");
+  fj.fj_coh = p.number("fj_coh", Range::non_negative(), 0.0, "Pa");
+  fj.fj_fa = p.number("fj_fa", Range::half_open(0, 90), 0.0, "deg");
+  fj.fj_exact = p.boolean("fj_exact", false);
+  if (dim == 2 && fj.fj_exact)
+    p.fail("fj_exact", "is a 3D option (the 2D element integrals are always exact)");
+  double lo, hi;
+  read_bond_option(p, false, fj.bond, lo, hi);
+  if (fj.bond && fj.fj_gap0 > 0)
+    p.fail("bond", "only elements with a zero gap can be bonded, but fj_gap0 > 0");
+  return fj;
+}
+
+nlohmann::json FlatJoint::state_json(const Contact& f, ConstElements els, int dim) {
+  nlohmann::json j{{"fj_radius", f.R},
+                   {"fj_gap", f.gs},
+                   {"fj_kn", f.kn},
+                   {"fj_ks", f.ks},
+                   {"fj_mtype", f.mtype},
+                   {"fj_Nr", f.geo->Nr},
+                   {"fj_Nal", f.geo->Nal},
+                   {"fj_exact", f.exact},
+                   {"fj_relbr", nlohmann::json::array({f.tbs, f.tbt})},
+                   {"fj_relsd", nlohmann::json::array({f.dss, f.dst})}};
+  nlohmann::json elements = nlohmann::json::array();
+  for (std::size_t i = 0; i < els.size(); ++i) {
+    const FlatJointElement& e = els[i];
+    const double A = f.geo->A[i] * (dim == 2 ? f.R : f.R * f.R);
+    const double se = f.geo->s[i] * f.R, te = f.geo->t[i] * f.R;
+    elements.push_back({{"e", i + 1},
+                        {"fj_state", e.B},
+                        {"fj_slip", e.slip},
+                        {"fj_area", A},
+                        {"fj_cen_st", nlohmann::json::array({se, te})},
+                        {"fj_egap", flatjoint::gap_at(f, se, te)},
+                        {"fj_sigma", e.Fn / A},
+                        {"fj_tau", std::hypot(e.Fss, e.Fst) / A},
+                        {"force", {{"Fn", e.Fn}, {"Fss", e.Fss}, {"Fst", e.Fst}}},
+                        {"moment", {{"Mt", e.Mt}, {"Mbs", e.Mbs}, {"Mbt", e.Mbt}}},
+                        {"E_slip", e.E_slip}});
+  }
+  j["elements"] = std::move(elements);
+  return j;
+}
+
 } // namespace rocklab

@@ -4,10 +4,12 @@
 #pragma once
 
 #include "contact/contact_model.hpp"
+#include "io/input_error.hpp"
 
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace rocklab {
@@ -32,12 +34,12 @@ struct FlatJointProps {
 
 /// Element state (memo Table 4, per element).
 struct FlatJointElement {
-  double Fn = 0;           ///< normal force, > 0 tension [N]
-  double Fss = 0, Fst = 0; ///< shear force [N]
-  double Mbs = 0, Mbt = 0; ///< bending moment about the element centroid [N m]
-  double Mt = 0;           ///< twisting moment about the element centroid (exact 3D) [N m]
-  double E_slip = 0;       ///< slip energy (Eq. 39) [J]
-  std::uint8_t B = 0;      ///< 0 unbonded, 1 broke in tension, 2 broke in shear, 3 bonded
+  double Fn = 0;                 ///< normal force, > 0 tension [N]
+  double Fss = 0, Fst = 0;       ///< shear force [N]
+  double Mbs = 0, Mbt = 0;       ///< bending moment about the element centroid [N m]
+  double Mt = 0;                 ///< twisting moment about the element centroid (exact 3D) [N m]
+  double E_slip = 0;             ///< slip energy (Eq. 39) [J]
+  BondState B = BondState::None; ///< bond state of the element
   bool slip = false;
 };
 
@@ -68,16 +70,6 @@ struct FlatJointContact {
 
 namespace flatjoint {
 
-/// Create a contact: parameters, radius (Eq. 30), elements appended to `elements`.
-FlatJointContact make(const FlatJointProps& p, int dim, double R1, double R2, bool ball_facet,
-                      std::vector<FlatJointElement>& elements);
-void update(FlatJointContact& c, std::span<FlatJointElement> e, const ContactKinematics& k,
-            ContactResult& out, EventSink& events) noexcept;
-ContactStiffness stiffness(const FlatJointContact& c);
-ContactEnergy energy(const FlatJointContact& c, std::span<const FlatJointElement> e);
-/// Active if any element is bonded or the interface gap is negative somewhere (section 1.6);
-/// may be deleted once the notional surfaces are a flat-joint diameter apart.
-bool keeps_alive(const FlatJointContact& c, std::span<const FlatJointElement> e);
 /// The bond method: bond every element whose gap is zero over its whole surface (`first` is the
 /// index of e[0] among the contact's elements).
 void bond(FlatJointContact& c, std::span<FlatJointElement> e, std::size_t first = 0);
@@ -100,4 +92,80 @@ Moments clipped_moments(double r1, double r2, double a1, double a2, double gs, d
 void element_2d(double kn, double rbar, double ga, double gb, bool bonded, double& Fn, double& Mb);
 
 } // namespace flatjoint
+
+/// The elements of every flat joint of a batch, contact by contact (the model's Pool).
+struct FlatJointElements {
+  std::vector<FlatJointElement> all;
+
+  std::span<FlatJointElement> of(const FlatJointContact& c) {
+    return {all.data() + c.elem, c.n_elem};
+  }
+  std::span<const FlatJointElement> of(const FlatJointContact& c) const {
+    return {all.data() + c.elem, c.n_elem};
+  }
+  void clear() { all.clear(); }
+  /// Copy a contact's elements from another pool; returns the contact pointing at the copy.
+  FlatJointContact adopt(const FlatJointElements& from, FlatJointContact c) {
+    const auto e = from.of(c);
+    c.elem = static_cast<std::uint32_t>(all.size());
+    all.insert(all.end(), e.begin(), e.end());
+    return c;
+  }
+};
+
+/// The flat-joint model: traits for the registry (contact_model.hpp). Functions that read element
+/// state take the contact's elements beside it.
+struct FlatJoint {
+  static constexpr std::string_view name = "flatjoint";
+  using Props = FlatJointProps;
+  using Contact = FlatJointContact;
+  using Pool = FlatJointElements;
+  using Elements = std::span<FlatJointElement>;
+  using ConstElements = std::span<const FlatJointElement>;
+
+  /// Create a contact: parameters, radius (Eq. 30), elements appended to the pool.
+  static Contact make(const Props& p, const CreationInfo& ci, Pool& pool);
+  static void update(Contact& c, Elements e, const ContactKinematics& k, ContactResult& out,
+                     EventSink& events) noexcept;
+  static ContactStiffness stiffness(const Contact& c);
+  static ContactEnergy energy(const Contact& c, ConstElements e);
+  /// Active if any element is bonded or the interface gap is negative somewhere (section 1.6);
+  /// may be deleted once the notional surfaces are a flat-joint diameter apart.
+  static bool keeps_alive(const Contact& c, ConstElements e);
+  static BondView bond_view(const Contact& c, ConstElements e);
+  /// Settable properties: fj_fric [-].
+  static double* property(Contact& c, std::string_view name) {
+    return name == "fj_fric" ? &c.fric : nullptr;
+  }
+  static constexpr std::string_view methods[] = {"bond", "unbond"};
+  /// bond / unbond, on every element or on element `args.element` (1..N).
+  static void call(Contact& c, Elements e, const MethodArgs& args);
+  static Props read(JsonObject& p, int dim);
+  static nlohmann::json state_json(const Contact& c, ConstElements e, int dim);
+
+  template <class A> static void io(A& a, Props& p) {
+    a(p.fj_Nr), a(p.fj_Nal), a(p.fj_rmul), a(p.fj_gap0), a(p.fj_kn), a(p.fj_ks), a(p.fj_fric),
+        a(p.fj_ten), a(p.fj_coh), a(p.fj_fa), a(p.fj_emod), a(p.fj_kratio), a(p.bond),
+        a(p.fj_exact);
+  }
+  template <class A> static void io(A& a, Contact& c) {
+    a(c.kn), a(c.ks), a(c.fric), a(c.ten), a(c.coh), a(c.tan_fa), a(c.rmul), a(c.gap0);
+    int dim = c.geo ? c.geo->dim : 3, nr = c.geo ? c.geo->Nr : 1, nal = c.geo ? c.geo->Nal : 3;
+    a(dim), a(nr), a(nal);
+    if constexpr (A::reading) {
+      if ((dim != 2 && dim != 3) || nr < 1 || nal < 1 || nr > 1000 || nal > 1000)
+        throw InputError("corrupt specimen body (flat-joint discretisation)");
+      c.geo = &flat_joint_geometry(dim, nr, nal);
+    }
+    a(c.elem), a(c.n_elem), a(c.exact), a(c.fixed), a(c.mtype), a(c.R), a(c.gs), a(c.dss), a(c.dst),
+        a(c.tbs), a(c.tbt);
+  }
+  template <class A> static void io(A& a, FlatJointElement& e) {
+    a(e.Fn), a(e.Fss), a(e.Fst), a(e.Mbs), a(e.Mbt), a(e.Mt), a(e.E_slip), a(e.B), a(e.slip);
+  }
+  template <class A> static void io(A& a, Pool& pool) {
+    a.vec(pool.all, [&](FlatJointElement& e) { io(a, e); });
+  }
+};
+
 } // namespace rocklab

@@ -1,6 +1,7 @@
 #include "contact/impact_models.hpp"
 
 #include "contact/linear.hpp"
+#include "io/json_input.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,58 +9,24 @@
 
 namespace rocklab {
 
-namespace {
+using contactbond::point_bond_break;
 
-// The contact-bond break rule (thesis 4.4), shared by the bonded models: tension at or above
-// `tenf` breaks in tension, else shear at or above `shearf` in shear. A broken bond raises its
-// event (with the strain energy `stored()` gives before the forces change), records the mode in
-// `state`, and leaves no force in tension and the shear cut to the friction limit in
-// compression. Returns true if the bond broke.
-template <class StoredEnergy>
-bool point_bond_break(double tenf, double shearf, double fric, double& Fn, double& Fss, double& Fst,
-                      std::uint8_t& state, EventSink& events, StoredEnergy&& stored) noexcept {
-  const double Fs = std::sqrt(Fss * Fss + Fst * Fst);
-  const int mode = Fn >= tenf ? 1 : (Fs >= shearf ? 2 : 0);
-  if (mode == 0)
-    return false;
-  Event e;
-  e.type = EventType::BondBreak;
-  e.mode = mode;
-  e.strength = mode == 1 ? tenf : shearf;
-  e.energy = stored();
-  e.size = 0; // a point bond
-  events.raise(e);
-  state = static_cast<std::uint8_t>(mode);
-  if (mode == 1 || Fn > 0) {
-    Fn = Fss = Fst = 0;
-  } else if (Fs > -fric * Fn) { // the friction limit takes over
-    const double scale = -fric * Fn / Fs;
-    Fss *= scale;
-    Fst *= scale;
-  }
-  return true;
-}
-
-} // namespace
-
-namespace contactbond {
-
-ContactBondContact make(const ContactBondProps& p, int dim, double R1, double R2, bool ball_facet,
-                        double gap) {
-  ContactBondContact c;
-  c.lin.p = linear::make_params(p.linear, dim, R1, R2, ball_facet);
+ContactBond::Contact ContactBond::make(const Props& p, const CreationInfo& ci) {
+  const double gap = ci.gap;
+  Contact c;
+  c.lin.p = linear::make_params(p.linear, ci);
   c.lin.p.lin_mode = 0; // the bond's normal force is the absolute spring force
   c.tenf = p.cb_tenf;
   c.shearf = p.cb_shearf;
   if (p.bond && gap >= p.bond_gap_lo && gap <= p.bond_gap_hi)
-    c.state = 3;
+    c.state = BondState::Bonded;
   return c;
 }
 
-void update(ContactBondContact& c, const ContactKinematics& k, ContactResult& out,
-            EventSink& events) noexcept {
-  if (c.state != 3) {
-    linear::update(c.lin, k, out, events);
+void ContactBond::update(Contact& c, const ContactKinematics& k, ContactResult& out,
+                         EventSink& events) noexcept {
+  if (c.state != BondState::Bonded) {
+    Linear::update(c.lin, k, out, events);
     return;
   }
   LinearState& s = c.lin.s;
@@ -68,16 +35,12 @@ void update(ContactBondContact& c, const ContactKinematics& k, ContactResult& ou
   s.Fn = p.kn * (k.gap - p.rgap);
   linear::shear_update(p.ks, p.fric, s.Fn, s.Fss, s.Fst, s.E_slip, s.slip, k, events, false);
   point_bond_break(c.tenf, c.shearf, p.fric, s.Fn, s.Fss, s.Fst, c.state, events,
-                   [&] { return linear::energy(c.lin).strain; });
+                   [&] { return Linear::energy(c.lin).strain; });
   out = ContactResult{s.Fn, s.Fss, s.Fst, 0, 0, 0};
 }
 
-} // namespace contactbond
-
-namespace hysteresis {
-
-HysteresisContact make(const HysteresisProps& p) {
-  HysteresisContact c;
+Hysteretic::Contact Hysteretic::make(const Props& p, const CreationInfo&) {
+  Contact c;
   const double d = p.hys_dampn;
   c.k_load = 2 * d * p.hys_knm / (1 + d); // Eq. 21
   c.k_unload = 2 * p.hys_knm / (1 + d);   // Eq. 22
@@ -86,13 +49,13 @@ HysteresisContact make(const HysteresisProps& p) {
   c.tenf = p.hys_tenf;
   c.shearf = p.hys_shearf;
   if (c.tenf > 0 || c.shearf > 0)
-    c.state = 3;
+    c.state = BondState::Bonded;
   return c;
 }
 
-void update(HysteresisContact& c, const ContactKinematics& k, ContactResult& out,
-            EventSink& events) noexcept {
-  if (c.state == 3) {
+void Hysteretic::update(Contact& c, const ContactKinematics& k, ContactResult& out,
+                        EventSink& events) noexcept {
+  if (c.state == BondState::Bonded) {
     // Bonded: the same loading/unloading springs, but tension is carried (opening unloads with
     // K_unload, continuing into tension) and the shear does not slip; the bond breaks like a
     // contact bond (thesis 4.4).
@@ -132,12 +95,8 @@ void update(HysteresisContact& c, const ContactKinematics& k, ContactResult& out
   out = ContactResult{c.Fn, c.Fss, c.Fst, 0, 0, 0};
 }
 
-} // namespace hysteresis
-
-namespace powerplastic {
-
-PowerPlasticContact make(const PowerPlasticProps& p) {
-  PowerPlasticContact c;
+PowerPlastic::Contact PowerPlastic::make(const Props& p, const CreationInfo&) {
+  Contact c;
   c.kn = p.pp_kn;
   c.ks = p.pp_ks;
   c.fric = p.pp_fric;
@@ -145,6 +104,8 @@ PowerPlasticContact make(const PowerPlasticProps& p) {
   c.b = p.pp_b;
   return c;
 }
+
+namespace powerplastic {
 
 double normal_force(const PowerPlasticContact& c, double x, double& x_m, double& F_m) noexcept {
   x_m = c.x_max;
@@ -162,8 +123,11 @@ double normal_force(const PowerPlasticContact& c, double x, double& x_m, double&
   return F_m * std::pow(x / x_m, c.b);
 }
 
-void update(PowerPlasticContact& c, const ContactKinematics& k, ContactResult& out,
-            EventSink& events) noexcept {
+} // namespace powerplastic
+
+void PowerPlastic::update(Contact& c, const ContactKinematics& k, ContactResult& out,
+                          EventSink& events) noexcept {
+  using namespace powerplastic;
   const double x = std::max(-k.gap, 0.0); // overlap
   const double F0 = -c.Fn;
   double x_m, F_m;
@@ -187,6 +151,8 @@ void update(PowerPlasticContact& c, const ContactKinematics& k, ContactResult& o
   out = ContactResult{c.Fn, c.Fss, c.Fst, 0, 0, 0};
 }
 
+namespace powerplastic {
+
 double restitution(double m, double v, double kn, double T, double b) {
   const double ek = 0.5 * m * v * v;
   const double e = T / kn; // elastic displacement at the transition force
@@ -199,5 +165,61 @@ double restitution(double m, double v, double kn, double T, double b) {
 }
 
 } // namespace powerplastic
+
+ContactBond::Props ContactBond::read(JsonObject& p, int) {
+  Props cb;
+  cb.linear = linear::read_props(p, false);
+  cb.cb_tenf = p.number("cb_tenf", Range::non_negative(), 0.0, "N");
+  cb.cb_shearf = p.number("cb_shearf", Range::non_negative(), 0.0, "N");
+  read_bond_option(p, true, cb.bond, cb.bond_gap_lo, cb.bond_gap_hi);
+  return cb;
+}
+
+nlohmann::json ContactBond::state_json(const Contact& cb, int) {
+  nlohmann::json j = linear::state_json(cb.lin.p, cb.lin.s);
+  j["cb_state"] = cb.state;
+  j["cb_tenf"] = cb.tenf;
+  j["cb_shearf"] = cb.shearf;
+  return j;
+}
+
+Hysteretic::Props Hysteretic::read(JsonObject& p, int) {
+  Props h;
+  h.hys_knm = p.number("hys_knm", Range::positive(), std::nullopt, "N/m");
+  h.hys_dampn = p.number("hys_dampn", {0, 1, true, false}, 1.0);
+  h.hys_ks = p.number("hys_ks", Range::non_negative(), 0.0, "N/m");
+  h.hys_fric = p.number("hys_fric", Range::non_negative(), 0.0);
+  h.hys_tenf = p.number("hys_tenf", Range::non_negative(), 0.0, "N");
+  h.hys_shearf = p.number("hys_shearf", Range::non_negative(), 0.0, "N");
+  return h;
+}
+
+nlohmann::json Hysteretic::state_json(const Contact& h, int) {
+  return {{"hys_kload", h.k_load},
+          {"hys_kunload", h.k_unload},
+          {"hys_force", {{"Fn", h.Fn}, {"Fss", h.Fss}, {"Fst", h.Fst}}},
+          {"hys_slip", h.slip},
+          {"E_hysteresis", h.E_hys},
+          {"E_slip", h.E_slip}};
+}
+
+PowerPlastic::Props PowerPlastic::read(JsonObject& p, int) {
+  Props pp;
+  pp.pp_kn = p.number("pp_kn", Range::positive(), std::nullopt, "N/m");
+  pp.pp_ks = p.number("pp_ks", Range::non_negative(), 0.0, "N/m");
+  pp.pp_fric = p.number("pp_fric", Range::non_negative(), 0.0);
+  pp.pp_T = p.number("pp_T", Range::positive(), std::numeric_limits<double>::infinity(), "N");
+  pp.pp_b = p.number("pp_b", {1, 1000, false, false}, 1.0);
+  return pp;
+}
+
+nlohmann::json PowerPlastic::state_json(const Contact& pp, int) {
+  return {{"pp_force", {{"Fn", pp.Fn}, {"Fss", pp.Fss}, {"Fst", pp.Fst}}},
+          {"pp_xmax", pp.x_max},
+          {"pp_fmax", pp.F_max},
+          {"pp_slip", pp.slip},
+          {"E_plastic", pp.E_plastic},
+          {"E_slip", pp.E_slip}};
+}
 
 } // namespace rocklab

@@ -14,8 +14,10 @@
 #include "contact/contact_model.hpp"
 #include "contact/linear.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
+#include <string_view>
 
 namespace rocklab {
 
@@ -37,35 +39,90 @@ struct ContactBondProps {
 struct ContactBondContact {
   LinearContact lin;
   double tenf = 0, shearf = 0; ///< [N]
-  std::uint8_t state = 0;      ///< 0 never bonded, 1 broke in tension, 2 broke in shear, 3 bonded
+  BondState state = BondState::None;
 };
 
 namespace contactbond {
 
-ContactBondContact make(const ContactBondProps& p, int dim, double R1, double R2, bool ball_facet,
-                        double gap);
-void update(ContactBondContact& c, const ContactKinematics& k, ContactResult& out,
-            EventSink& events) noexcept;
-inline ContactStiffness stiffness(const ContactBondContact& c) {
-  return linear::stiffness(c.lin);
-}
-inline ContactEnergy energy(const ContactBondContact& c) {
-  ContactEnergy e = linear::energy(c.lin);
-  if (c.state == 3) { // the bonded spring's energy is bond energy (thesis section 3.4)
-    e.bond_strain = e.strain;
-    e.strain = 0;
+/// The contact-bond break rule (thesis 4.4), shared by the bonded models of point contacts:
+/// tension at or above `tenf` breaks in tension, else shear at or above `shearf` in shear. A broken
+/// bond raises its event (with the strain energy `stored` before the forces change), records the
+/// mode in `state`, and leaves no force in tension and the shear cut to the friction limit in
+/// compression. Returns true if the bond broke.
+template <class StoredEnergy>
+bool point_bond_break(double tenf, double shearf, double fric, double& Fn, double& Fss, double& Fst,
+                      BondState& state, EventSink& events, StoredEnergy&& stored) noexcept {
+  const double Fs = std::sqrt(Fss * Fss + Fst * Fst);
+  const int mode = Fn >= tenf ? 1 : (Fs >= shearf ? 2 : 0);
+  if (mode == 0)
+    return false;
+  Event e;
+  e.type = EventType::BondBreak;
+  e.mode = mode;
+  e.strength = mode == 1 ? tenf : shearf;
+  e.energy = stored();
+  e.size = 0; // a point bond
+  events.raise(e);
+  state = broken_state(mode);
+  if (mode == 1 || Fn > 0) {
+    Fn = Fss = Fst = 0;
+  } else if (Fs > -fric * Fn) { // the friction limit takes over
+    const double scale = -fric * Fn / Fs;
+    Fss *= scale;
+    Fst *= scale;
   }
-  return e;
-}
-inline bool keeps_alive(const ContactBondContact& c) {
-  return c.state == 3;
+  return true;
 }
 
 } // namespace contactbond
 
+/// The contact-bond model (PFC `linearcbond`): traits for the registry (contact_model.hpp).
+struct ContactBond {
+  static constexpr std::string_view name = "contactbond";
+  using Props = ContactBondProps;
+  using Contact = ContactBondContact;
+
+  static Contact make(const Props& p, const CreationInfo& ci);
+  static void update(Contact& c, const ContactKinematics& k, ContactResult& out,
+                     EventSink& events) noexcept;
+  static ContactStiffness stiffness(const Contact& c) { return Linear::stiffness(c.lin); }
+  static ContactEnergy energy(const Contact& c) {
+    ContactEnergy e = Linear::energy(c.lin);
+    if (c.state == BondState::Bonded) { // the bonded spring's energy is bond energy (3.4)
+      e.bond_strain = e.strain;
+      e.strain = 0;
+    }
+    return e;
+  }
+  static bool keeps_alive(const Contact& c) { return c.state == BondState::Bonded; }
+  static BondView bond_view(const Contact& c) { return point_bond_view(c.state); }
+  static void inherit(Props& p, const SurfaceProps& a, const SurfaceProps& b) {
+    Linear::inherit(p.linear, a, b);
+  }
+  /// Settable properties: fric [-] (of the linear component).
+  static double* property(Contact& c, std::string_view name) {
+    return name == "fric" ? &c.lin.p.fric : nullptr;
+  }
+  static constexpr std::string_view methods[] = {"bond", "unbond"};
+  static void call(Contact& c, const MethodArgs& m) {
+    c.state = m.name == "bond" ? BondState::Bonded : BondState::None;
+  }
+  static Props read(JsonObject& p, int dim);
+  static nlohmann::json state_json(const Contact& c, int dim);
+
+  template <class A> static void io(A& a, Props& p) {
+    Linear::io(a, p.linear);
+    a(p.cb_tenf), a(p.cb_shearf), a(p.bond), a(p.bond_gap_lo), a(p.bond_gap_hi);
+  }
+  template <class A> static void io(A& a, Contact& c) {
+    Linear::io(a, c.lin);
+    a(c.tenf), a(c.shearf), a(c.state);
+  }
+};
+
 // ---------------------------------------------------------------- hysteretic damping (4.6)
 
-struct HysteresisProps {
+struct HystereticProps {
   double hys_knm = 0;   ///< mean normal stiffness (K_load + K_unload) / 2 [N/m]
   double hys_dampn = 1; ///< K_load / K_unload, (0, 1] [-]
   double hys_ks = 0;    ///< shear stiffness [N/m]
@@ -76,7 +133,7 @@ struct HysteresisProps {
   double hys_shearf = 0;
 };
 
-struct HysteresisContact {
+struct HystereticContact {
   double k_load = 0, k_unload = 0, ks = 0, fric = 0; ///< [N/m], [-]
   double Fn = 0; ///< normal force, <= 0 (compression; tension positive convention) [N]
   double Fss = 0, Fst = 0;
@@ -85,33 +142,47 @@ struct HysteresisContact {
   double E_slip = 0;
   bool slip = false;
   double tenf = 0, shearf = 0; ///< bond strengths [N]
-  std::uint8_t state = 0;      ///< 0 never bonded, 1 broke in tension, 2 in shear, 3 bonded
+  BondState state = BondState::None;
 };
 
-namespace hysteresis {
+/// The hysteretic damping model: traits for the registry (contact_model.hpp).
+struct Hysteretic {
+  static constexpr std::string_view name = "hysteretic";
+  using Props = HystereticProps;
+  using Contact = HystereticContact;
 
-/// K_load = 2 d k / (1 + d) (Eq. 21), K_unload = 2 k / (1 + d) (Eq. 22), d = hys_dampn.
-HysteresisContact make(const HysteresisProps& p);
-void update(HysteresisContact& c, const ContactKinematics& k, ContactResult& out,
-            EventSink& events) noexcept;
-inline ContactStiffness stiffness(const HysteresisContact& c) {
-  return {c.k_unload + c.ks, c.ks, 0.0};
-}
-inline ContactEnergy energy(const HysteresisContact& c) {
-  ContactEnergy e;
-  if (c.k_unload > 0)
-    e.strain = 0.5 * c.Fn * c.Fn / c.k_unload; // what unloading would give back
-  if (c.ks > 0)
-    e.strain += 0.5 * (c.Fss * c.Fss + c.Fst * c.Fst) / c.ks;
-  e.slip = c.E_slip;
-  e.dashpot = c.E_hys;
-  return e;
-}
-inline bool keeps_alive(const HysteresisContact& c) {
-  return c.state == 3;
-}
+  /// K_load = 2 d k / (1 + d) (Eq. 21), K_unload = 2 k / (1 + d) (Eq. 22), d = hys_dampn.
+  static Contact make(const Props& p, const CreationInfo& ci);
+  static void update(Contact& c, const ContactKinematics& k, ContactResult& out,
+                     EventSink& events) noexcept;
+  static ContactStiffness stiffness(const Contact& c) { return {c.k_unload + c.ks, c.ks, 0.0}; }
+  static ContactEnergy energy(const Contact& c) {
+    ContactEnergy e;
+    if (c.k_unload > 0)
+      e.strain = 0.5 * c.Fn * c.Fn / c.k_unload; // what unloading would give back
+    if (c.ks > 0)
+      e.strain += 0.5 * (c.Fss * c.Fss + c.Fst * c.Fst) / c.ks;
+    e.slip = c.E_slip;
+    e.dashpot = c.E_hys;
+    return e;
+  }
+  static bool keeps_alive(const Contact& c) { return c.state == BondState::Bonded; }
+  static BondView bond_view(const Contact& c) { return point_bond_view(c.state); }
+  /// Settable properties: hys_fric [-].
+  static double* property(Contact& c, std::string_view name) {
+    return name == "hys_fric" ? &c.fric : nullptr;
+  }
+  static Props read(JsonObject& p, int dim);
+  static nlohmann::json state_json(const Contact& c, int dim);
 
-} // namespace hysteresis
+  template <class A> static void io(A& a, Props& p) {
+    a(p.hys_knm), a(p.hys_dampn), a(p.hys_ks), a(p.hys_fric), a(p.hys_tenf), a(p.hys_shearf);
+  }
+  template <class A> static void io(A& a, Contact& c) {
+    a(c.k_load), a(c.k_unload), a(c.ks), a(c.fric), a(c.Fn), a(c.Fss), a(c.Fst), a(c.W_normal),
+        a(c.E_hys), a(c.E_slip), a(c.slip), a(c.tenf), a(c.shearf), a(c.state);
+  }
+};
 
 // ------------------------------------- elastic-perfectly-plastic power function (section 5)
 
@@ -137,33 +208,14 @@ struct PowerPlasticContact {
 
 namespace powerplastic {
 
-PowerPlasticContact make(const PowerPlasticProps& p);
 /// Normal force magnitude for overlap x given the turning point (x_m, F_m): beyond the turning
 /// point elastic loading k_n capped at T (perfectly plastic); below it the power branch
 /// F = a x^b with a = F_m / x_m^b (Eq. 23), which returns to the origin.
 double normal_force(const PowerPlasticContact& c, double x, double& x_m, double& F_m) noexcept;
-void update(PowerPlasticContact& c, const ContactKinematics& k, ContactResult& out,
-            EventSink& events) noexcept;
-inline ContactStiffness stiffness(const PowerPlasticContact& c) {
-  const double kmax = c.kn * (c.b > 1 ? c.b : 1.0);
-  return {kmax + c.ks, c.ks, 0.0};
-}
 /// Recoverable energy on the power branch: integral of a x^b from 0 to x = F x / (b + 1)
 /// (Eq. 28); plastic = work done - recoverable.
 inline double recoverable(const PowerPlasticContact& c) {
   return -c.Fn * c.x / (c.b + 1);
-}
-inline ContactEnergy energy(const PowerPlasticContact& c) {
-  ContactEnergy e;
-  e.strain = recoverable(c);
-  if (c.ks > 0)
-    e.strain += 0.5 * (c.Fss * c.Fss + c.Fst * c.Fst) / c.ks;
-  e.slip = c.E_slip;
-  e.plastic = c.E_plastic;
-  return e;
-}
-inline bool keeps_alive(const PowerPlasticContact&) {
-  return false;
 }
 /// Closed-form normal restitution of one impact (Eq. 25-30) of mass m at speed v on a rigid
 /// obstacle: sqrt(2 / (b + 1)) sqrt((g + 1) / (g + 2)), g = e / p, e = T / k_n; without
@@ -171,5 +223,44 @@ inline bool keeps_alive(const PowerPlasticContact&) {
 double restitution(double m, double v, double kn, double T, double b);
 
 } // namespace powerplastic
+
+/// The elastic-perfectly-plastic power-function model: traits for the registry.
+struct PowerPlastic {
+  static constexpr std::string_view name = "powerplastic";
+  using Props = PowerPlasticProps;
+  using Contact = PowerPlasticContact;
+
+  static Contact make(const Props& p, const CreationInfo& ci);
+  static void update(Contact& c, const ContactKinematics& k, ContactResult& out,
+                     EventSink& events) noexcept;
+  static ContactStiffness stiffness(const Contact& c) {
+    const double kmax = c.kn * (c.b > 1 ? c.b : 1.0);
+    return {kmax + c.ks, c.ks, 0.0};
+  }
+  static ContactEnergy energy(const Contact& c) {
+    ContactEnergy e;
+    e.strain = powerplastic::recoverable(c);
+    if (c.ks > 0)
+      e.strain += 0.5 * (c.Fss * c.Fss + c.Fst * c.Fst) / c.ks;
+    e.slip = c.E_slip;
+    e.plastic = c.E_plastic;
+    return e;
+  }
+  static bool keeps_alive(const Contact&) { return false; }
+  /// Settable properties: pp_fric [-].
+  static double* property(Contact& c, std::string_view name) {
+    return name == "pp_fric" ? &c.fric : nullptr;
+  }
+  static Props read(JsonObject& p, int dim);
+  static nlohmann::json state_json(const Contact& c, int dim);
+
+  template <class A> static void io(A& a, Props& p) {
+    a(p.pp_kn), a(p.pp_ks), a(p.pp_fric), a(p.pp_T), a(p.pp_b);
+  }
+  template <class A> static void io(A& a, Contact& c) {
+    a(c.kn), a(c.ks), a(c.fric), a(c.T), a(c.b), a(c.x_max), a(c.F_max), a(c.x), a(c.Fn), a(c.Fss),
+        a(c.Fst), a(c.W_normal), a(c.E_plastic), a(c.E_slip), a(c.slip);
+  }
+};
 
 } // namespace rocklab

@@ -1,12 +1,18 @@
 #include "contact/linear.hpp"
 
+#include "io/json_input.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
-namespace rocklab::linear {
+namespace rocklab {
+namespace linear {
 
-LinearParams make_params(const LinearProps& p, int dim, double R1, double R2, bool ball_facet) {
+LinearParams make_params(const LinearProps& p, const CreationInfo& ci) {
+  const int dim = ci.dim;
+  const double R1 = ci.R1, R2 = ci.R2;
+  const bool ball_facet = ci.ball_facet;
   LinearParams q;
   q.kn = p.kn;
   q.ks = p.ks;
@@ -70,8 +76,48 @@ void shear_update(double ks, double fric, double Fn, double& Fss, double& Fst, d
   }
 }
 
-void update(LinearContact& c, const ContactKinematics& k, ContactResult& out, EventSink& events,
-            bool force_active) noexcept {
+LinearProps read_props(JsonObject& p, bool kn_required) {
+  LinearProps lp;
+  const bool deform = p.has("emod");
+  if (deform && (p.has("kn") || p.has("ks")))
+    p.fail("emod", "give either the stiffnesses kn/ks or the deformability emod/kratio, not both");
+  if (deform) {
+    lp.emod = p.number("emod", Range::positive(), std::nullopt, "Pa");
+    lp.kratio = p.number("kratio", Range::non_negative(), 0.0);
+    lp.user_area = p.number("user_area", Range::non_negative(), 0.0, "m^2");
+  } else {
+    lp.kn = p.number("kn", Range::non_negative(),
+                     kn_required ? std::nullopt : std::optional<double>(0.0), "N/m");
+    lp.ks = p.number("ks", Range::non_negative(), 0.0, "N/m");
+  }
+  lp.fric = p.number("fric", Range::non_negative(), 0.0);
+  lp.rgap = p.number("rgap", Range::any(), 0.0, "m");
+  lp.lin_mode = static_cast<int>(p.integer("lin_mode", 0, 1, 0));
+  lp.dp_nratio = p.number("dp_nratio", Range::closed(0, 1), 0.0);
+  lp.dp_sratio = p.number("dp_sratio", Range::closed(0, 1), 0.0);
+  lp.dp_mode = static_cast<int>(p.integer("dp_mode", 0, 3, 0));
+  return lp;
+}
+
+nlohmann::json state_json(const LinearParams& p, const LinearState& s) {
+  return nlohmann::json{{"kn", p.kn},
+                        {"ks", p.ks},
+                        {"fric", p.fric},
+                        {"lin_slip", s.slip},
+                        {"lin_force", {{"Fn", s.Fn}, {"Fss", s.Fss}, {"Fst", s.Fst}}},
+                        {"E_slip", s.E_slip},
+                        {"E_dashpot", s.E_dashpot}};
+}
+
+} // namespace linear
+
+nlohmann::json Linear::state_json(const Contact& c, int) {
+  return linear::state_json(c.p, c.s);
+}
+
+void Linear::update(Contact& c, const ContactKinematics& k, ContactResult& out, EventSink& events,
+                    bool force_active) noexcept {
+  using namespace linear;
   const LinearParams& p = c.p;
   LinearState& s = c.s;
   const double gs = k.gap - p.rgap;
@@ -110,4 +156,4 @@ void update(LinearContact& c, const ContactKinematics& k, ContactResult& out, Ev
   out = ContactResult{s.Fn + Fdn, s.Fss + Fdss, s.Fst + Fdst, 0, 0, 0};
 }
 
-} // namespace rocklab::linear
+} // namespace rocklab

@@ -1,5 +1,7 @@
 #include "contact/smooth_joint.hpp"
 
+#include "io/json_input.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -10,6 +12,8 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 }
 
+namespace smoothjoint {
+
 Vec3 joint_normal(int dim, double dip_deg, double ddir_deg) {
   const double p = dip_deg * kDeg, d = ddir_deg * kDeg;
   if (dim == 2)
@@ -17,11 +21,14 @@ Vec3 joint_normal(int dim, double dip_deg, double ddir_deg) {
   return Vec3(std::sin(p) * std::sin(d), std::sin(p) * std::cos(d), std::cos(p)); // Eq. 1, 3D
 }
 
-namespace smoothjoint {
+} // namespace smoothjoint
 
-SmoothJointContact make(const SmoothJointProps& p, int dim, double R1, double R2, const Vec3& n_c,
-                        double gap) {
-  SmoothJointContact c;
+SmoothJoint::Contact SmoothJoint::make(const Props& p, const CreationInfo& ci) {
+  using namespace smoothjoint;
+  const int dim = ci.dim;
+  const double R1 = ci.R1, R2 = ci.R2;
+  const Vec3& n_c = ci.n;
+  Contact c;
   c.kn = p.sj_kn;
   c.ks = p.sj_ks;
   c.fric = p.sj_fric;
@@ -37,23 +44,25 @@ SmoothJointContact make(const SmoothJointProps& p, int dim, double R1, double R2
   const Vec3 nj = p.use_normal ? Vec3(p.normal.normalized()) : joint_normal(dim, p.dip, p.ddir);
   c.nj = n_c.dot(nj) >= 0 ? nj : Vec3(-nj);
   if (p.bond)
-    bond(c, gap, p.bond_gap_lo, p.bond_gap_hi);
+    bond(c, ci.gap, p.bond_gap_lo, p.bond_gap_hi);
   return c;
 }
 
+namespace smoothjoint {
+
 void bond(SmoothJointContact& c, double gap, double lo, double hi) {
   if (gap >= lo && gap <= hi)
-    c.state = 3;
+    c.state = BondState::Bonded;
 }
 
 void unbond(SmoothJointContact& c, double gap, double lo, double hi) {
   if (gap >= lo && gap <= hi)
-    c.state = 0;
+    c.state = BondState::None;
 }
 
-void update(SmoothJointContact& c, const Vec3& d_delta, double gap, Vec3& force,
-            EventSink& events) noexcept {
-  const bool bonded = c.state == 3;
+void update_global(SmoothJointContact& c, const Vec3& d_delta, double gap, Vec3& force,
+                   EventSink& events) noexcept {
+  const bool bonded = c.state == BondState::Bonded;
   // Large-strain mode: active only while bonded or overlapping.
   if (c.large && !bonded && gap >= 0) {
     c.Fn = 0;
@@ -117,11 +126,11 @@ void update(SmoothJointContact& c, const Vec3& d_delta, double gap, Vec3& force,
       e.type = EventType::BondBreak;
       e.mode = mode;
       e.strength = mode == 1 ? c.ten : tau_c;
-      e.energy = energy(c).strain;
+      e.energy = SmoothJoint::energy(c).strain;
       e.normal = c.nj;
       e.size = 2 * std::sqrt(c.A / std::numbers::pi);
       events.raise(e);
-      c.state = static_cast<std::uint8_t>(mode);
+      c.state = broken_state(mode);
       if (mode == 1 || c.Fn > 0) { // Eq. 14
         c.Fn = 0;
         c.Fs.setZero();
@@ -142,11 +151,9 @@ void update(SmoothJointContact& c, const Vec3& d_delta, double gap, Vec3& force,
   force = -c.Fn * c.nj + c.Fs; // Eq. 5-6
 }
 
-ContactStiffness stiffness(const SmoothJointContact& c) {
-  return {(c.kn + c.ks) * c.A, c.ks * c.A, 0.0};
-}
+} // namespace smoothjoint
 
-ContactEnergy energy(const SmoothJointContact& c) {
+ContactEnergy SmoothJoint::energy(const Contact& c) {
   ContactEnergy e; // Eq. 16 with the stiffnesses times the joint area
   if (c.kn > 0)
     e.strain += 0.5 * c.Fn * c.Fn / (c.kn * c.A);
@@ -156,5 +163,40 @@ ContactEnergy energy(const SmoothJointContact& c) {
   return e;
 }
 
-} // namespace smoothjoint
+SmoothJoint::Props SmoothJoint::read(JsonObject& p, int dim) {
+  const Range angle = Range::half_open(0, 90);
+  Props sj;
+  sj.sj_kn = p.number("sj_kn", Range::non_negative(), 0.0, "Pa/m");
+  sj.sj_ks = p.number("sj_ks", Range::non_negative(), 0.0, "Pa/m");
+  sj.sj_fric = p.number("sj_fric", Range::non_negative(), 0.0);
+  sj.sj_da = p.number("sj_da", angle, 0.0, "deg");
+  sj.sj_ten = p.number("sj_ten", Range::non_negative(), 0.0, "Pa");
+  sj.sj_coh = p.number("sj_coh", Range::non_negative(), 0.0, "Pa");
+  sj.sj_fa = p.number("sj_fa", angle, 0.0, "deg");
+  sj.sj_rmul = p.number("sj_rmul", Range::positive(), 1.0);
+  sj.sj_large = p.boolean("sj_large", false);
+  if (p.has("normal")) {
+    if (p.has("dip") || p.has("ddir"))
+      p.fail("normal", "give either the joint normal or dip / ddir, not both");
+    sj.use_normal = true;
+    sj.normal = p.vec("normal", dim);
+    if (sj.normal.norm() == 0)
+      p.fail("normal", "the joint normal must not be the zero vector");
+  } else {
+    sj.dip = p.number("dip", Range::closed(0, 360), 0.0, "deg");
+    sj.ddir = p.number("ddir", Range::closed(0, 360), 0.0, "deg");
+    if (dim == 2 && p.has("ddir"))
+      p.fail("ddir", "is a 3D property");
+  }
+  read_bond_option(p, false, sj.bond, sj.bond_gap_lo, sj.bond_gap_hi);
+  return sj;
+}
+
+nlohmann::json SmoothJoint::state_json(const Contact& sj, int) {
+  auto v3 = [](const Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
+  return {{"sj_state", sj.state},  {"sj_slip", sj.slip}, {"sj_fn", sj.Fn},     {"sj_fs", v3(sj.Fs)},
+          {"sj_unorm", v3(sj.nj)}, {"sj_un", sj.un},     {"sj_us", v3(sj.us)}, {"sj_gap", sj.gj},
+          {"sj_area", sj.A},       {"E_slip", sj.E_slip}};
+}
+
 } // namespace rocklab

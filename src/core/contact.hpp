@@ -32,7 +32,7 @@ struct Contact {
   std::int32_t end2 = -1;  ///< ball index (ball-ball) or wall index (ball-facet)
   std::int32_t facet = -1; ///< nearest facet of the wall (ball-facet)
   ContactKind kind = ContactKind::BallBall;
-  ModelKind model = ModelKind::Linear;
+  ModelKind model = model_kind<Linear>;
   std::uint32_t slot = 0; ///< index into the model's batch
   bool initialized = false;
   Vec3 n = Vec3::UnitX(); ///< normal, from piece 1 to piece 2

@@ -941,114 +941,43 @@ void Model::drain_events(std::vector<Event>& out) {
 std::size_t Model::apply_method(ModelKind kind, const std::string& method, double gap_lo,
                                 double gap_hi, int element) {
   std::size_t count = 0;
-  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
-    Contact& c = contacts_[ci];
-    if (c.model != kind)
-      continue;
-    ++count;
-    const double gap = c.gap;
-    switch (kind) {
-    case ModelKind::PBond:
-      if (method == "bond")
-        pbond::bond(batches_.pbond[c.slot], gap, gap_lo, gap_hi);
-      else
-        pbond::unbond(batches_.pbond[c.slot], gap, gap_lo, gap_hi);
-      break;
-    case ModelKind::FlatJoint: {
-      FlatJointContact& fj = batches_.flatjoint[c.slot];
-      auto els = batches_.elements(fj);
-      if (element > static_cast<int>(els.size()))
-        throw std::invalid_argument("flat-joint method '" + method + "': element " +
-                                    std::to_string(element) + " is out of range [1, " +
-                                    std::to_string(els.size()) + "]");
-      const auto part = element > 0 ? els.subspan(static_cast<std::size_t>(element - 1), 1) : els;
-      const std::size_t first = element > 0 ? static_cast<std::size_t>(element - 1) : 0;
-      if (method == "bond")
-        flatjoint::bond(fj, part, first);
-      else
-        flatjoint::unbond(fj, part);
-      break;
+  visit_model(kind, [&]<class M>() {
+    Batch<M>& batch = batches_.of<M>();
+    for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+      Contact& c = contacts_[ci];
+      if (c.model != kind)
+        continue;
+      ++count;
+      if constexpr (HasMethods<M>) {
+        const MethodArgs args{method, gap_lo, gap_hi, element, c.gap, outputs_[ci].force};
+        with_contact<M>(batch, c.slot, [&](auto&&... x) { M::call(x..., args); });
+      }
+      outputs_[ci].stiff = M::stiffness(batch.contacts[c.slot]);
     }
-    case ModelKind::SmoothJoint: {
-      SmoothJointContact& sj = batches_.smoothjoint[c.slot];
-      if (method == "bond")
-        smoothjoint::bond(sj, gap, gap_lo, gap_hi);
-      else if (method == "unbond")
-        smoothjoint::unbond(sj, gap, gap_lo, gap_hi);
-      else
-        smoothjoint::set_force(sj, outputs_[ci].force);
-      break;
-    }
-    case ModelKind::ContactBond:
-      if (method == "bond")
-        batches_.contactbond[c.slot].state = 3;
-      else
-        batches_.contactbond[c.slot].state = 0;
-      break;
-    case ModelKind::Linear:
-    case ModelKind::Hysteresis:
-    case ModelKind::PowerPlastic:
-      break;
-    }
-    outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);
-  }
+  });
   return count;
 }
 
 std::size_t Model::set_property(ModelKind kind, const std::string& name, double value,
                                 ContactSelect which) {
-  auto unknown = [&] {
-    return std::invalid_argument("contact property '" + name + "' is not a property of model '" +
-                                 std::string(model_name(kind)) + "'");
-  };
-  double LinearParams::*linear_field = nullptr;
-  if (kind == ModelKind::Linear || kind == ModelKind::PBond || kind == ModelKind::ContactBond) {
-    if (name == "fric")
-      linear_field = &LinearParams::fric;
-    else if (name == "kn" && kind == ModelKind::Linear)
-      linear_field = &LinearParams::kn;
-    else if (name == "ks" && kind == ModelKind::Linear)
-      linear_field = &LinearParams::ks;
-    else
-      throw unknown();
-  } else if ((kind == ModelKind::FlatJoint && name != "fj_fric") ||
-             (kind == ModelKind::SmoothJoint && name != "sj_fric") ||
-             (kind == ModelKind::Hysteresis && name != "hys_fric") ||
-             (kind == ModelKind::PowerPlastic && name != "pp_fric")) {
-    throw unknown();
-  }
   std::size_t count = 0;
-  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
-    const Contact& c = contacts_[ci];
-    if (c.model != kind || (which == ContactSelect::BallBall && c.kind != ContactKind::BallBall) ||
-        (which == ContactSelect::BallFacet && c.kind != ContactKind::BallFacet))
-      continue;
-    ++count;
-    switch (kind) {
-    case ModelKind::Linear:
-      batches_.linear[c.slot].p.*linear_field = value;
-      break;
-    case ModelKind::PBond:
-      batches_.pbond[c.slot].lp.*linear_field = value;
-      break;
-    case ModelKind::FlatJoint:
-      batches_.flatjoint[c.slot].fric = value;
-      break;
-    case ModelKind::SmoothJoint:
-      batches_.smoothjoint[c.slot].fric = value;
-      break;
-    case ModelKind::Hysteresis:
-      batches_.hysteresis[c.slot].fric = value;
-      break;
-    case ModelKind::ContactBond:
-      batches_.contactbond[c.slot].lin.p.*linear_field = value;
-      break;
-    case ModelKind::PowerPlastic:
-      batches_.powerplastic[c.slot].fric = value;
-      break;
+  visit_model(kind, [&]<class M>() {
+    typename M::Contact probe{};
+    if (!M::property(probe, name))
+      throw std::invalid_argument("contact property '" + name + "' is not a property of model '" +
+                                  std::string(M::name) + "'");
+    Batch<M>& batch = batches_.of<M>();
+    for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+      const Contact& c = contacts_[ci];
+      if (c.model != kind ||
+          (which == ContactSelect::BallBall && c.kind != ContactKind::BallBall) ||
+          (which == ContactSelect::BallFacet && c.kind != ContactKind::BallFacet))
+        continue;
+      ++count;
+      *M::property(batch.contacts[c.slot], name) = value;
+      outputs_[ci].stiff = M::stiffness(batch.contacts[c.slot]);
     }
-    outputs_[ci].stiff = contact_stiffness(batches_, c.model, c.slot);
-  }
+  });
   return count;
 }
 

@@ -160,8 +160,13 @@ std::string JsonObject::string(const std::string& key, std::optional<std::string
 
 std::string JsonObject::choice(const std::string& key, std::initializer_list<const char*> allowed,
                                std::optional<std::string> def) {
+  return choice(key, std::vector<std::string>(allowed.begin(), allowed.end()), std::move(def));
+}
+
+std::string JsonObject::choice(const std::string& key, const std::vector<std::string>& allowed,
+                               std::optional<std::string> def) {
   std::string list;
-  for (const char* a : allowed) {
+  for (const std::string& a : allowed) {
     if (!list.empty())
       list += ", ";
     list += '"';
@@ -174,7 +179,7 @@ std::string JsonObject::choice(const std::string& key, std::initializer_list<con
                      ")");
   }
   const std::string v = string(key, def);
-  for (const char* a : allowed)
+  for (const std::string& a : allowed)
     if (v == a)
       return v;
   fail(key, "value \"" + v + "\" is not allowed (one of " + list + ")");

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "core/types.hpp"
+#include "io/input_error.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -15,10 +16,6 @@
 #include <vector>
 
 namespace rocklab {
-
-struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 /// An interval of allowed values; open or closed at each end.
 struct Range {
@@ -54,6 +51,8 @@ public:
   bool boolean(const std::string& key, std::optional<bool> def = std::nullopt);
   std::string string(const std::string& key, std::optional<std::string> def = std::nullopt);
   std::string choice(const std::string& key, std::initializer_list<const char*> allowed,
+                     std::optional<std::string> def = std::nullopt);
+  std::string choice(const std::string& key, const std::vector<std::string>& allowed,
                      std::optional<std::string> def = std::nullopt);
   /// A vector of `dim` numbers (2D input may give 2 components; z is then 0).
   Vec3 vec(const std::string& key, int dim, std::optional<Vec3> def = std::nullopt,

@@ -1,5 +1,7 @@
 #include "io/results.hpp"
 
+#include "contact/model_json.hpp"
+
 #include <charconv>
 #include <cmath>
 
@@ -11,116 +13,8 @@ nlohmann::json vec_json(const Vec3& v, int dim) {
     return nlohmann::json::array({v.x(), v.y()});
   return nlohmann::json::array({v.x(), v.y(), v.z()});
 }
-nlohmann::json vec3_json(const Vec3& v) {
-  return nlohmann::json::array({v.x(), v.y(), v.z()});
-}
 
 } // namespace
-
-nlohmann::json contact_state_json(const ModelBatches& b, const Contact& c, int dim) {
-  auto linear_json = [](const LinearParams& p, const LinearState& s) {
-    return nlohmann::json{{"kn", p.kn},
-                          {"ks", p.ks},
-                          {"fric", p.fric},
-                          {"lin_slip", s.slip},
-                          {"lin_force", {{"Fn", s.Fn}, {"Fss", s.Fss}, {"Fst", s.Fst}}},
-                          {"E_slip", s.E_slip},
-                          {"E_dashpot", s.E_dashpot}};
-  };
-  switch (c.model) {
-  case ModelKind::Linear: {
-    const LinearContact& l = b.linear[c.slot];
-    return linear_json(l.p, l.s);
-  }
-  case ModelKind::PBond: {
-    const PBondContact& p = b.pbond[c.slot];
-    nlohmann::json j = linear_json(p.lp, p.ls);
-    j["pb_state"] = p.s.state;
-    j["pb_radius"] = p.s.R;
-    j["pb_kn"] = p.p.kn;
-    j["pb_ks"] = p.p.ks;
-    j["pb_gap"] = p.s.gs;
-    j["pb_sigma"] = p.s.sigma;
-    j["pb_tau"] = p.s.tau;
-    j["pb_force"] = {{"Fn", p.s.Fn}, {"Fss", p.s.Fss}, {"Fst", p.s.Fst}};
-    j["pb_moment"] = {{"Mt", p.s.Mt}, {"Mbs", p.s.Mbs}, {"Mbt", p.s.Mbt}};
-    return j;
-  }
-  case ModelKind::FlatJoint: {
-    const FlatJointContact& f = b.flatjoint[c.slot];
-    const auto els = b.elements(f);
-    nlohmann::json j{{"fj_radius", f.R},
-                     {"fj_gap", f.gs},
-                     {"fj_kn", f.kn},
-                     {"fj_ks", f.ks},
-                     {"fj_mtype", f.mtype},
-                     {"fj_Nr", f.geo->Nr},
-                     {"fj_Nal", f.geo->Nal},
-                     {"fj_exact", f.exact},
-                     {"fj_relbr", nlohmann::json::array({f.tbs, f.tbt})},
-                     {"fj_relsd", nlohmann::json::array({f.dss, f.dst})}};
-    nlohmann::json elements = nlohmann::json::array();
-    for (std::size_t i = 0; i < els.size(); ++i) {
-      const FlatJointElement& e = els[i];
-      const double A = f.geo->A[i] * (dim == 2 ? f.R : f.R * f.R);
-      const double se = f.geo->s[i] * f.R, te = f.geo->t[i] * f.R;
-      elements.push_back({{"e", i + 1},
-                          {"fj_state", e.B},
-                          {"fj_slip", e.slip},
-                          {"fj_area", A},
-                          {"fj_cen_st", nlohmann::json::array({se, te})},
-                          {"fj_egap", flatjoint::gap_at(f, se, te)},
-                          {"fj_sigma", e.Fn / A},
-                          {"fj_tau", std::hypot(e.Fss, e.Fst) / A},
-                          {"force", {{"Fn", e.Fn}, {"Fss", e.Fss}, {"Fst", e.Fst}}},
-                          {"moment", {{"Mt", e.Mt}, {"Mbs", e.Mbs}, {"Mbt", e.Mbt}}},
-                          {"E_slip", e.E_slip}});
-    }
-    j["elements"] = std::move(elements);
-    return j;
-  }
-  case ModelKind::ContactBond: {
-    const ContactBondContact& cb = b.contactbond[c.slot];
-    nlohmann::json j = linear_json(cb.lin.p, cb.lin.s);
-    j["cb_state"] = cb.state;
-    j["cb_tenf"] = cb.tenf;
-    j["cb_shearf"] = cb.shearf;
-    return j;
-  }
-  case ModelKind::Hysteresis: {
-    const HysteresisContact& h = b.hysteresis[c.slot];
-    return {{"hys_kload", h.k_load},
-            {"hys_kunload", h.k_unload},
-            {"hys_force", {{"Fn", h.Fn}, {"Fss", h.Fss}, {"Fst", h.Fst}}},
-            {"hys_slip", h.slip},
-            {"E_hysteresis", h.E_hys},
-            {"E_slip", h.E_slip}};
-  }
-  case ModelKind::PowerPlastic: {
-    const PowerPlasticContact& pp = b.powerplastic[c.slot];
-    return {{"pp_force", {{"Fn", pp.Fn}, {"Fss", pp.Fss}, {"Fst", pp.Fst}}},
-            {"pp_xmax", pp.x_max},
-            {"pp_fmax", pp.F_max},
-            {"pp_slip", pp.slip},
-            {"E_plastic", pp.E_plastic},
-            {"E_slip", pp.E_slip}};
-  }
-  case ModelKind::SmoothJoint: {
-    const SmoothJointContact& sj = b.smoothjoint[c.slot];
-    return {{"sj_state", sj.state},
-            {"sj_slip", sj.slip},
-            {"sj_fn", sj.Fn},
-            {"sj_fs", vec3_json(sj.Fs)},
-            {"sj_unorm", vec3_json(sj.nj)},
-            {"sj_un", sj.un},
-            {"sj_us", vec3_json(sj.us)},
-            {"sj_gap", sj.gj},
-            {"sj_area", sj.A},
-            {"E_slip", sj.E_slip}};
-  }
-  }
-  return {};
-}
 
 std::string format_double(double v) {
   char buf[64];
@@ -211,7 +105,7 @@ nlohmann::json results_json(const Model& m, const EventCounts& counts,
                       {"moment", dim == 2 ? nlohmann::json(o.moment.z()) : vec_json(o.moment, dim)},
                       {"force_local", {{"Fn", local.Fn}, {"Fss", local.Fss}, {"Fst", local.Fst}}},
                       {"moment_local", {{"Mt", local.Mt}, {"Mbs", local.Mbs}, {"Mbt", local.Mbt}}}};
-    jc["state"] = contact_state_json(m.batches(), c, dim);
+    jc["state"] = contact_state_json(m.batches(), c.model, c.slot, dim);
     contacts.push_back(std::move(jc));
   }
   out["contacts"] = std::move(contacts);

@@ -12,9 +12,6 @@ namespace rocklab {
 nlohmann::json results_json(const Model& m, const EventCounts& counts,
                             const std::string& scene_file);
 
-/// Model state of one contact (per-element state for flat joints), SI units.
-nlohmann::json contact_state_json(const ModelBatches& b, const Contact& c, int dim);
-
 /// Energies as a JSON object (joules).
 nlohmann::json energy_json(const EnergyLedger& e);
 

@@ -1,5 +1,6 @@
 #include "io/scene.hpp"
 
+#include "contact/model_json.hpp"
 #include "io/results.hpp"
 
 #include <algorithm>
@@ -318,175 +319,6 @@ void read_balls(JsonObject& top, Model& m) {
                      ": the scene has no balls (give 'balls', 'generate' or 'clumps')");
 }
 
-LinearProps read_linear_props(JsonObject& p, bool kn_required) {
-  LinearProps lp;
-  const bool deform = p.has("emod");
-  if (deform && (p.has("kn") || p.has("ks")))
-    p.fail("emod", "give either the stiffnesses kn/ks or the deformability emod/kratio, not both");
-  if (deform) {
-    lp.emod = p.number("emod", Range::positive(), std::nullopt, "Pa");
-    lp.kratio = p.number("kratio", Range::non_negative(), 0.0);
-    lp.user_area = p.number("user_area", Range::non_negative(), 0.0, "m^2");
-  } else {
-    lp.kn = p.number("kn", Range::non_negative(),
-                     kn_required ? std::nullopt : std::optional<double>(0.0), "N/m");
-    lp.ks = p.number("ks", Range::non_negative(), 0.0, "N/m");
-  }
-  lp.fric = p.number("fric", Range::non_negative(), 0.0);
-  lp.rgap = p.number("rgap", Range::any(), 0.0, "m");
-  lp.lin_mode = static_cast<int>(p.integer("lin_mode", 0, 1, 0));
-  lp.dp_nratio = p.number("dp_nratio", Range::closed(0, 1), 0.0);
-  lp.dp_sratio = p.number("dp_sratio", Range::closed(0, 1), 0.0);
-  lp.dp_mode = static_cast<int>(p.integer("dp_mode", 0, 3, 0));
-  return lp;
-}
-
-// The bond method at creation: true/false, a maximum gap, or {"gap": [lo, hi]}.
-void read_bond(JsonObject& p, bool default_bond, bool& bond, double& lo, double& hi) {
-  bond = default_bond;
-  lo = -1e300;
-  hi = 0;
-  if (!p.has("bond"))
-    return;
-  const auto& v = p.raw("bond");
-  if (v.is_boolean()) {
-    bond = v.get<bool>();
-  } else if (v.is_number()) {
-    bond = true;
-    hi = v.get<double>();
-  } else if (v.is_object() && v.size() == 1 && v.contains("gap") && v["gap"].is_array() &&
-             v["gap"].size() == 2 && v["gap"][0].is_number() && v["gap"][1].is_number() &&
-             v["gap"][0].get<double>() <= v["gap"][1].get<double>()) {
-    bond = true;
-    lo = v["gap"][0].get<double>();
-    hi = v["gap"][1].get<double>();
-  } else {
-    p.fail("bond", "expected true/false, a maximum gap in m, or {\"gap\": [lo, hi]} with "
-                   "lo <= hi, got " +
-                       describe(v));
-  }
-}
-
-const Range kAngle = Range::half_open(0, 90);
-
-ModelProps read_model_props(JsonObject& p, const std::string& model, int dim) {
-  if (model == "linear") {
-    LinearProps lp = read_linear_props(p, true);
-    p.finish();
-    return lp;
-  }
-  if (model == "linearpbond") {
-    PBondProps pb;
-    pb.linear = read_linear_props(p, false);
-    pb.pb_rmul = p.number("pb_rmul", Range::positive(), 1.0);
-    const bool deform = p.has("pb_emod");
-    if (deform && (p.has("pb_kn") || p.has("pb_ks")))
-      p.fail("pb_emod", "give either pb_kn/pb_ks or pb_emod/pb_kratio, not both");
-    if (deform) {
-      pb.pb_emod = p.number("pb_emod", Range::positive(), std::nullopt, "Pa");
-      pb.pb_kratio = p.number("pb_kratio", Range::non_negative(), 0.0);
-    } else {
-      pb.pb_kn = p.number("pb_kn", Range::non_negative(), 0.0, "Pa/m");
-      pb.pb_ks = p.number("pb_ks", Range::non_negative(), 0.0, "Pa/m");
-    }
-    pb.pb_mcf = p.number("pb_mcf", Range::closed(0, 1), 1.0);
-    pb.pb_ten = p.number("pb_ten", Range::non_negative(), 0.0, "Pa");
-    pb.pb_coh = p.number("pb_coh", Range::non_negative(), 0.0, "Pa");
-    pb.pb_fa = p.number("pb_fa", kAngle, 0.0, "deg");
-    read_bond(p, true, pb.bond, pb.bond_gap_lo, pb.bond_gap_hi);
-    p.finish();
-    return pb;
-  }
-  if (model == "flatjoint") {
-    FlatJointProps fj;
-    fj.fj_Nr = static_cast<int>(p.integer("fj_Nr", 1, 1000, 2));
-    fj.fj_Nal = static_cast<int>(p.integer("fj_Nal", 3, 1000, 4));
-    if (dim == 2 && p.has("fj_Nal"))
-      p.fail("fj_Nal", "is a 3D property (2D flat joints have fj_Nr elements only)");
-    fj.fj_rmul = p.number("fj_rmul", Range::positive(), 1.0);
-    fj.fj_gap0 = p.number("fj_gap0", Range::non_negative(), 0.0, "m");
-    const bool deform = p.has("fj_emod");
-    if (deform && (p.has("fj_kn") || p.has("fj_ks")))
-      p.fail("fj_emod", "give either fj_kn/fj_ks or fj_emod/fj_kratio, not both");
-    if (deform) {
-      fj.fj_emod = p.number("fj_emod", Range::positive(), std::nullopt, "Pa");
-      fj.fj_kratio = p.number("fj_kratio", Range::non_negative(), 0.0);
-    } else {
-      fj.fj_kn = p.number("fj_kn", Range::non_negative(), 0.0, "Pa/m");
-      fj.fj_ks = p.number("fj_ks", Range::non_negative(), 0.0, "Pa/m");
-    }
-    fj.fj_fric = p.number("fj_fric", Range::non_negative(), 0.0);
-    fj.fj_ten = p.number("fj_ten", Range::non_negative(), 0.0, "Pa");
-    fj.fj_coh = p.number("fj_coh", Range::non_negative(), 0.0, "Pa");
-    fj.fj_fa = p.number("fj_fa", kAngle, 0.0, "deg");
-    fj.fj_exact = p.boolean("fj_exact", false);
-    if (dim == 2 && fj.fj_exact)
-      p.fail("fj_exact", "is a 3D option (the 2D element integrals are always exact)");
-    double lo, hi;
-    read_bond(p, false, fj.bond, lo, hi);
-    if (fj.bond && fj.fj_gap0 > 0)
-      p.fail("bond", "only elements with a zero gap can be bonded, but fj_gap0 > 0");
-    p.finish();
-    return fj;
-  }
-  if (model == "contactbond") {
-    ContactBondProps cb;
-    cb.linear = read_linear_props(p, false);
-    cb.cb_tenf = p.number("cb_tenf", Range::non_negative(), 0.0, "N");
-    cb.cb_shearf = p.number("cb_shearf", Range::non_negative(), 0.0, "N");
-    read_bond(p, true, cb.bond, cb.bond_gap_lo, cb.bond_gap_hi);
-    p.finish();
-    return cb;
-  }
-  if (model == "hysteretic") {
-    HysteresisProps h;
-    h.hys_knm = p.number("hys_knm", Range::positive(), std::nullopt, "N/m");
-    h.hys_dampn = p.number("hys_dampn", {0, 1, true, false}, 1.0);
-    h.hys_ks = p.number("hys_ks", Range::non_negative(), 0.0, "N/m");
-    h.hys_fric = p.number("hys_fric", Range::non_negative(), 0.0);
-    h.hys_tenf = p.number("hys_tenf", Range::non_negative(), 0.0, "N");
-    h.hys_shearf = p.number("hys_shearf", Range::non_negative(), 0.0, "N");
-    p.finish();
-    return h;
-  }
-  if (model == "powerplastic") {
-    PowerPlasticProps pp;
-    pp.pp_kn = p.number("pp_kn", Range::positive(), std::nullopt, "N/m");
-    pp.pp_ks = p.number("pp_ks", Range::non_negative(), 0.0, "N/m");
-    pp.pp_fric = p.number("pp_fric", Range::non_negative(), 0.0);
-    pp.pp_T = p.number("pp_T", Range::positive(), std::numeric_limits<double>::infinity(), "N");
-    pp.pp_b = p.number("pp_b", {1, 1000, false, false}, 1.0);
-    p.finish();
-    return pp;
-  }
-  SmoothJointProps sj;
-  sj.sj_kn = p.number("sj_kn", Range::non_negative(), 0.0, "Pa/m");
-  sj.sj_ks = p.number("sj_ks", Range::non_negative(), 0.0, "Pa/m");
-  sj.sj_fric = p.number("sj_fric", Range::non_negative(), 0.0);
-  sj.sj_da = p.number("sj_da", kAngle, 0.0, "deg");
-  sj.sj_ten = p.number("sj_ten", Range::non_negative(), 0.0, "Pa");
-  sj.sj_coh = p.number("sj_coh", Range::non_negative(), 0.0, "Pa");
-  sj.sj_fa = p.number("sj_fa", kAngle, 0.0, "deg");
-  sj.sj_rmul = p.number("sj_rmul", Range::positive(), 1.0);
-  sj.sj_large = p.boolean("sj_large", false);
-  if (p.has("normal")) {
-    if (p.has("dip") || p.has("ddir"))
-      p.fail("normal", "give either the joint normal or dip / ddir, not both");
-    sj.use_normal = true;
-    sj.normal = p.vec("normal", dim);
-    if (sj.normal.norm() == 0)
-      p.fail("normal", "the joint normal must not be the zero vector");
-  } else {
-    sj.dip = p.number("dip", Range::closed(0, 360), 0.0, "deg");
-    sj.ddir = p.number("ddir", Range::closed(0, 360), 0.0, "deg");
-    if (dim == 2 && p.has("ddir"))
-      p.fail("ddir", "is a 3D property");
-  }
-  read_bond(p, false, sj.bond, sj.bond_gap_lo, sj.bond_gap_hi);
-  p.finish();
-  return sj;
-}
-
 void read_contact_models(JsonObject& top, Model& m) {
   for (const auto& [jr, path] : top.array("contact_models")) {
     JsonObject o(*jr, top.file(), path);
@@ -519,18 +351,17 @@ void read_contact_models(JsonObject& top, Model& m) {
         o.fail("wall", "no wall is named \"" + wname + "\"");
       rule.wall = found;
     }
-    const std::string model =
-        o.choice("model", {"linear", "linearpbond", "flatjoint", "smoothjoint", "hysteretic",
-                           "powerplastic", "contactbond"});
-    if (model == "smoothjoint" && rule.ball_facet)
-      o.fail("model", "the smooth-joint model is installed at ball-ball contacts only");
+    const std::string model = o.choice("model", model_names());
+    const ModelKind kind = model_kind_of(model);
+    if (rule.ball_facet && !model_allows_ball_facet(kind))
+      o.fail("model", "the " + model + " model is installed at ball-ball contacts only");
     JsonObject props = o.object("properties");
-    if (model == "linear" || model == "linearpbond" || model == "smoothjoint") {
+    if (model_inherits(kind)) {
       rule.inherit = props.boolean("inherit", false);
       if (rule.inherit && rule.ball_facet)
         props.fail("inherit", "walls hold no surface properties; inherit on ball-ball rules only");
     }
-    rule.props = read_model_props(props, model, m.settings.dim);
+    rule.props = read_contact_props(props, model, m.settings.dim);
     o.finish();
     m.rules.push_back(rule);
   }
@@ -712,10 +543,6 @@ std::vector<Pebble> read_clump_pebbles(JsonObject& o, int dim, bool position_req
   return pebbles;
 }
 
-ModelProps read_contact_props(JsonObject& p, const std::string& model, int dim) {
-  return read_model_props(p, model, dim);
-}
-
 Scene load_scene(const std::string& path) {
   Scene s;
   s.file = path;
@@ -800,14 +627,9 @@ Scene load_scene(const std::string& path) {
     for (const auto& [jm, mpath] : run.array("methods", false)) {
       JsonObject mo(*jm, path, mpath);
       MethodCall mc;
-      const std::string model =
-          mo.choice("model", {"linearpbond", "flatjoint", "smoothjoint", "contactbond"});
-      mc.model = model == "linearpbond"   ? ModelKind::PBond
-                 : model == "flatjoint"   ? ModelKind::FlatJoint
-                 : model == "contactbond" ? ModelKind::ContactBond
-                                          : ModelKind::SmoothJoint;
-      mc.method = model == "smoothjoint" ? mo.choice("method", {"bond", "unbond", "sj_setforce"})
-                                         : mo.choice("method", {"bond", "unbond"});
+      const std::string model = mo.choice("model", model_names(ModelUse::Methods));
+      mc.model = model_kind_of(model);
+      mc.method = mo.choice("method", model_methods(mc.model));
       if (mo.has("gap")) {
         const auto& g = mo.raw("gap");
         if (g.is_number()) {
@@ -821,7 +643,7 @@ Scene load_scene(const std::string& path) {
                   "expected a maximum gap or [lo, hi] in m with lo <= hi, got " + describe(g));
         }
       }
-      if (model == "flatjoint")
+      if (mc.model == model_kind<FlatJoint>)
         mc.element = static_cast<int>(mo.integer("element", 0, 1'000'000, 0));
       mo.finish();
       st.methods.push_back(mc);

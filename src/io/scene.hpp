@@ -55,7 +55,7 @@ struct BallChange {
 /// time limits count from the start of the stage.
 /// A contact-model method called at the start of a stage on every contact of one model.
 struct MethodCall {
-  ModelKind model = ModelKind::PBond;
+  ModelKind model = model_kind<LinearPBond>;
   std::string method;
   double gap_lo = -1e300, gap_hi = 0;
   int element = 0;
@@ -93,9 +93,6 @@ double history_value(const Model& m, const HistoryColumn& c, const EnergyLedger&
 /// 'template' + 'radius' (+ 'position' of the pebble centres' centroid, 'rotation': 2D degrees
 /// about z, 3D a rotation vector in degrees). Reads only those keys.
 std::vector<Pebble> read_clump_pebbles(JsonObject& o, int dim, bool position_required);
-/// The properties of one contact model ("linear", "hysteretic", "powerplastic", ...) from the
-/// keys of a contact_models entry (docs/scene-format.md).
-ModelProps read_contact_props(JsonObject& p, const std::string& model, int dim);
 /// One energy partition by name (energy/NAME columns): the entries of energy_json (results.hpp);
 /// an unknown name throws.
 double energy_partition(const EnergyLedger& e, const std::string& name);

@@ -77,113 +77,16 @@ struct ArchiveReader {
 
 namespace {
 
-template <class A> void io(A& a, LinearProps& p) {
-  a(p.kn), a(p.ks), a(p.fric), a(p.rgap), a(p.lin_mode), a(p.dp_nratio), a(p.dp_sratio),
-      a(p.dp_mode), a(p.emod), a(p.kratio), a(p.user_area);
-}
-template <class A> void io(A& a, PBondProps& p) {
-  io(a, p.linear);
-  a(p.pb_rmul), a(p.pb_kn), a(p.pb_ks), a(p.pb_mcf), a(p.pb_ten), a(p.pb_coh), a(p.pb_fa),
-      a(p.pb_emod), a(p.pb_kratio), a(p.bond), a(p.bond_gap_lo), a(p.bond_gap_hi);
-}
-template <class A> void io(A& a, FlatJointProps& p) {
-  a(p.fj_Nr), a(p.fj_Nal), a(p.fj_rmul), a(p.fj_gap0), a(p.fj_kn), a(p.fj_ks), a(p.fj_fric),
-      a(p.fj_ten), a(p.fj_coh), a(p.fj_fa), a(p.fj_emod), a(p.fj_kratio), a(p.bond), a(p.fj_exact);
-}
-template <class A> void io(A& a, SmoothJointProps& p) {
-  a(p.sj_kn), a(p.sj_ks), a(p.sj_fric), a(p.sj_da), a(p.sj_ten), a(p.sj_coh), a(p.sj_fa),
-      a(p.sj_rmul), a(p.sj_large), a(p.dip), a(p.ddir), a(p.use_normal), a(p.normal), a(p.bond),
-      a(p.bond_gap_lo), a(p.bond_gap_hi);
-}
-template <class A> void io(A& a, HysteresisProps& p) {
-  a(p.hys_knm), a(p.hys_dampn), a(p.hys_ks), a(p.hys_fric), a(p.hys_tenf), a(p.hys_shearf);
-}
-template <class A> void io(A& a, PowerPlasticProps& p) {
-  a(p.pp_kn), a(p.pp_ks), a(p.pp_fric), a(p.pp_T), a(p.pp_b);
-}
-template <class A> void io(A& a, HysteresisContact& c) {
-  a(c.k_load), a(c.k_unload), a(c.ks), a(c.fric), a(c.Fn), a(c.Fss), a(c.Fst), a(c.W_normal),
-      a(c.E_hys), a(c.E_slip), a(c.slip), a(c.tenf), a(c.shearf), a(c.state);
-}
-template <class A> void io(A& a, PowerPlasticContact& c) {
-  a(c.kn), a(c.ks), a(c.fric), a(c.T), a(c.b), a(c.x_max), a(c.F_max), a(c.x), a(c.Fn), a(c.Fss),
-      a(c.Fst), a(c.W_normal), a(c.E_plastic), a(c.E_slip), a(c.slip);
-}
-template <class A> void io(A& a, ContactBondProps& p) {
-  io(a, p.linear);
-  a(p.cb_tenf), a(p.cb_shearf), a(p.bond), a(p.bond_gap_lo), a(p.bond_gap_hi);
-}
 template <class A> void io(A& a, ModelProps& p) {
   std::uint8_t index = static_cast<std::uint8_t>(p.index());
   a(index);
   if constexpr (A::reading) {
-    switch (index) {
-    case 0:
-      p = LinearProps{};
-      break;
-    case 1:
-      p = PBondProps{};
-      break;
-    case 2:
-      p = FlatJointProps{};
-      break;
-    case 3:
-      p = SmoothJointProps{};
-      break;
-    case 4:
-      p = HysteresisProps{};
-      break;
-    case 5:
-      p = PowerPlasticProps{};
-      break;
-    case 6:
-      p = ContactBondProps{};
-      break;
-    default:
+    if (index >= kModelCount)
       throw InputError("corrupt specimen body (unknown contact model)");
-    }
+    visit_model(static_cast<ModelKind>(index), [&]<class M>() { p = typename M::Props{}; });
   }
-  std::visit([&](auto& v) { io(a, v); }, p);
-}
-template <class A> void io(A& a, LinearParams& p) {
-  a(p.kn), a(p.ks), a(p.fric), a(p.rgap), a(p.dp_nratio), a(p.dp_sratio), a(p.lin_mode),
-      a(p.dp_mode);
-}
-template <class A> void io(A& a, LinearState& s) {
-  a(s.Fn), a(s.Fss), a(s.Fst), a(s.E_slip), a(s.E_dashpot), a(s.slip);
-}
-template <class A> void io(A& a, LinearContact& c) {
-  io(a, c.p), io(a, c.s);
-}
-template <class A> void io(A& a, ContactBondContact& c) {
-  io(a, c.lin);
-  a(c.tenf), a(c.shearf), a(c.state);
-}
-template <class A> void io(A& a, PBondContact& c) {
-  io(a, c.lp), io(a, c.ls);
-  a(c.p.rmul), a(c.p.kn), a(c.p.ks), a(c.p.mcf), a(c.p.ten), a(c.p.coh), a(c.p.tan_fa);
-  a(c.s.Fn), a(c.s.Fss), a(c.s.Fst), a(c.s.Mt), a(c.s.Mbs), a(c.s.Mbt), a(c.s.gs), a(c.s.sigma),
-      a(c.s.tau), a(c.s.R), a(c.s.A), a(c.s.I), a(c.s.J), a(c.s.state);
-}
-template <class A> void io(A& a, FlatJointContact& c) {
-  a(c.kn), a(c.ks), a(c.fric), a(c.ten), a(c.coh), a(c.tan_fa), a(c.rmul), a(c.gap0);
-  int dim = c.geo ? c.geo->dim : 3, nr = c.geo ? c.geo->Nr : 1, nal = c.geo ? c.geo->Nal : 3;
-  a(dim), a(nr), a(nal);
-  if constexpr (A::reading) {
-    if ((dim != 2 && dim != 3) || nr < 1 || nal < 1 || nr > 1000 || nal > 1000)
-      throw InputError("corrupt specimen body (flat-joint discretisation)");
-    c.geo = &flat_joint_geometry(dim, nr, nal);
-  }
-  a(c.elem), a(c.n_elem), a(c.exact), a(c.fixed), a(c.mtype), a(c.R), a(c.gs), a(c.dss), a(c.dst),
-      a(c.tbs), a(c.tbt);
-}
-template <class A> void io(A& a, FlatJointElement& e) {
-  a(e.Fn), a(e.Fss), a(e.Fst), a(e.Mbs), a(e.Mbt), a(e.Mt), a(e.E_slip), a(e.B), a(e.slip);
-}
-template <class A> void io(A& a, SmoothJointContact& c) {
-  a(c.kn), a(c.ks), a(c.fric), a(c.tan_da), a(c.ten), a(c.coh), a(c.tan_fa), a(c.rmul), a(c.large),
-      a(c.nj), a(c.A), a(c.un), a(c.us), a(c.gj), a(c.Fn), a(c.Fs), a(c.E_slip), a(c.state),
-      a(c.slip);
+  visit_model(static_cast<ModelKind>(index),
+              [&]<class M>() { M::io(a, std::get<typename M::Props>(p)); });
 }
 template <class A> void io(A& a, Contact& c) {
   a(c.key), a(c.end1), a(c.end2), a(c.facet), a(c.kind), a(c.model), a(c.slot), a(c.initialized),
@@ -258,9 +161,12 @@ template <class A> void Model::serialize(A& a) {
   a.vec(group_names, [&](std::string& s) { a(s); });
   each(a, rules), each(a, surface);
   each(a, contacts_), each(a, outputs_);
-  each(a, batches_.linear), each(a, batches_.pbond), each(a, batches_.flatjoint),
-      each(a, batches_.fj_elements), each(a, batches_.smoothjoint), each(a, batches_.hysteresis),
-      each(a, batches_.powerplastic), each(a, batches_.contactbond);
+  for_each_model([&]<class M>() {
+    Batch<M>& b = batches_.of<M>();
+    a.vec(b.contacts, [&](typename M::Contact& c) { M::io(a, c); });
+    if constexpr (HasPool<M>)
+      M::io(a, b.pool);
+  });
   a(time_), a(dt_), a(margin_), a(max_ball_disp_), a(wall_disp_), a(max_speed_), a(dt_stiffness_),
       a(step_), a(initialized_);
   io(a, ledger_);

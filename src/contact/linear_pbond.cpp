@@ -1,10 +1,13 @@
-#include "contact/parallel_bond.hpp"
+#include "contact/linear_pbond.hpp"
+
+#include "io/json_input.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 
 namespace rocklab {
+namespace linearpbond {
 
 BondSection bond_section(double rmul, int dim, double R1, double R2, bool ball_facet) {
   const double R = rmul * (ball_facet ? R1 : std::min(R1, R2)); // Eq. 5
@@ -14,11 +17,34 @@ BondSection bond_section(double rmul, int dim, double R1, double R2, bool ball_f
   return {R, pi * R * R, 0.25 * pi * R * R * R * R, 0.5 * pi * R * R * R * R};
 }
 
-namespace pbond {
+void bond(LinearPBondContact& c, double gap, double lo, double hi) {
+  if (gap < lo || gap > hi)
+    return;
+  const LinearPBondState old = c.s;
+  c.s = LinearPBondState{};
+  c.s.R = old.R;
+  c.s.A = old.A;
+  c.s.I = old.I;
+  c.s.J = old.J;
+  c.s.state = BondState::Bonded;
+}
 
-PBondContact make(const PBondProps& p, int dim, double R1, double R2, bool ball_facet, double gap) {
-  PBondContact c;
-  c.lp = linear::make_params(p.linear, dim, R1, R2, ball_facet);
+void unbond(LinearPBondContact& c, double gap, double lo, double hi) {
+  if (gap < lo || gap > hi)
+    return;
+  c.s.state = BondState::None;
+}
+
+} // namespace linearpbond
+
+using namespace linearpbond;
+
+LinearPBond::Contact LinearPBond::make(const Props& p, const CreationInfo& ci) {
+  const int dim = ci.dim;
+  const double R1 = ci.R1, R2 = ci.R2;
+  const bool ball_facet = ci.ball_facet;
+  Contact c;
+  c.lp = linear::make_params(p.linear, ci);
   c.p.rmul = p.pb_rmul;
   c.p.kn = p.pb_kn;
   c.p.ks = p.pb_ks;
@@ -32,7 +58,7 @@ PBondContact make(const PBondProps& p, int dim, double R1, double R2, bool ball_
   c.p.coh = p.pb_coh;
   c.p.tan_fa = std::tan(p.pb_fa * std::numbers::pi / 180.0);
   if (p.bond)
-    bond(c, gap, p.bond_gap_lo, p.bond_gap_hi);
+    bond(c, ci.gap, p.bond_gap_lo, p.bond_gap_hi);
   const BondSection b = bond_section(c.p.rmul, dim, R1, R2, ball_facet);
   c.s.R = b.R;
   c.s.A = b.A;
@@ -41,29 +67,11 @@ PBondContact make(const PBondProps& p, int dim, double R1, double R2, bool ball_
   return c;
 }
 
-void bond(PBondContact& c, double gap, double lo, double hi) {
-  if (gap < lo || gap > hi)
-    return;
-  const PBondState old = c.s;
-  c.s = PBondState{};
-  c.s.R = old.R;
-  c.s.A = old.A;
-  c.s.I = old.I;
-  c.s.J = old.J;
-  c.s.state = 3;
-}
-
-void unbond(PBondContact& c, double gap, double lo, double hi) {
-  if (gap < lo || gap > hi)
-    return;
-  c.s.state = 0;
-}
-
 namespace {
-double bond_strain_energy(const PBondContact& c) {
-  const PBondState& b = c.s;
+double bond_strain_energy(const LinearPBondContact& c) {
+  const LinearPBondState& b = c.s;
   // Eq. 15
-  const PBondState& s = c.s;
+  const LinearPBondState& s = c.s;
   if (b.A <= 0)
     return 0;
   double e = 0;
@@ -78,18 +86,18 @@ double bond_strain_energy(const PBondContact& c) {
 }
 } // namespace
 
-void update(PBondContact& c, const ContactKinematics& k, ContactResult& out,
-            EventSink& events) noexcept {
-  const bool bonded = c.s.state == 3;
+void LinearPBond::update(Contact& c, const ContactKinematics& k, ContactResult& out,
+                         EventSink& events) noexcept {
+  const bool bonded = c.s.state == BondState::Bonded;
   // The linear component and dashpots, as in the linear model (Eq. 1); dashpots also act while
   // bonded because the contact is then active.
   LinearContact lin{c.lp, c.ls};
-  linear::update(lin, k, out, events, /*force_active=*/bonded);
+  Linear::update(lin, k, out, events, /*force_active=*/bonded);
   c.ls = lin.s;
   if (!bonded)
     return;
 
-  PBondState& s = c.s;
+  LinearPBondState& s = c.s;
   const BondSection b = bond_section(c.p.rmul, k.dim, k.R1, k.R2, k.ball_facet);
   s.R = b.R;
   s.A = b.A;
@@ -130,7 +138,7 @@ void update(PBondContact& c, const ContactKinematics& k, ContactResult& out,
     e.size = 2 * b.R;
     events.raise(e);
     s.Fn = s.Fss = s.Fst = s.Mt = s.Mbs = s.Mbt = 0;
-    s.state = static_cast<std::uint8_t>(mode);
+    s.state = broken_state(mode);
     return;
   }
   // Eq. 1-3: the bond force and moment act in parallel with the linear force.
@@ -142,9 +150,9 @@ void update(PBondContact& c, const ContactKinematics& k, ContactResult& out,
   out.Mbt += s.Mbt;
 }
 
-ContactStiffness stiffness(const PBondContact& c) {
+ContactStiffness LinearPBond::stiffness(const Contact& c) {
   ContactStiffness st{c.lp.kn + c.lp.ks, c.lp.ks, 0.0};
-  if (c.s.state == 3) { // the bond's translational and rotational stiffnesses
+  if (c.s.state == BondState::Bonded) { // the bond's translational and rotational stiffnesses
     st.k_tran += (c.p.kn + c.p.ks) * c.s.A;
     st.k_shear += c.p.ks * c.s.A;
     st.k_rot += c.p.kn * c.s.I + c.p.ks * c.s.J;
@@ -152,12 +160,47 @@ ContactStiffness stiffness(const PBondContact& c) {
   return st;
 }
 
-ContactEnergy energy(const PBondContact& c) {
-  ContactEnergy e = linear::energy(LinearContact{c.lp, c.ls});
-  if (c.s.state == 3)
+ContactEnergy LinearPBond::energy(const Contact& c) {
+  ContactEnergy e = Linear::energy(LinearContact{c.lp, c.ls});
+  if (c.s.state == BondState::Bonded)
     e.bond_strain = bond_strain_energy(c);
   return e;
 }
 
-} // namespace pbond
+LinearPBond::Props LinearPBond::read(JsonObject& p, int) {
+  Props pb;
+  pb.linear = linear::read_props(p, false);
+  pb.pb_rmul = p.number("pb_rmul", Range::positive(), 1.0);
+  const bool deform = p.has("pb_emod");
+  if (deform && (p.has("pb_kn") || p.has("pb_ks")))
+    p.fail("pb_emod", "give either pb_kn/pb_ks or pb_emod/pb_kratio, not both");
+  if (deform) {
+    pb.pb_emod = p.number("pb_emod", Range::positive(), std::nullopt, "Pa");
+    pb.pb_kratio = p.number("pb_kratio", Range::non_negative(), 0.0);
+  } else {
+    pb.pb_kn = p.number("pb_kn", Range::non_negative(), 0.0, "Pa/m");
+    pb.pb_ks = p.number("pb_ks", Range::non_negative(), 0.0, "Pa/m");
+  }
+  pb.pb_mcf = p.number("pb_mcf", Range::closed(0, 1), 1.0);
+  pb.pb_ten = p.number("pb_ten", Range::non_negative(), 0.0, "Pa");
+  pb.pb_coh = p.number("pb_coh", Range::non_negative(), 0.0, "Pa");
+  pb.pb_fa = p.number("pb_fa", Range::half_open(0, 90), 0.0, "deg");
+  read_bond_option(p, true, pb.bond, pb.bond_gap_lo, pb.bond_gap_hi);
+  return pb;
+}
+
+nlohmann::json LinearPBond::state_json(const Contact& c, int) {
+  nlohmann::json j = linear::state_json(c.lp, c.ls);
+  j["pb_state"] = c.s.state;
+  j["pb_radius"] = c.s.R;
+  j["pb_kn"] = c.p.kn;
+  j["pb_ks"] = c.p.ks;
+  j["pb_gap"] = c.s.gs;
+  j["pb_sigma"] = c.s.sigma;
+  j["pb_tau"] = c.s.tau;
+  j["pb_force"] = {{"Fn", c.s.Fn}, {"Fss", c.s.Fss}, {"Fst", c.s.Fst}};
+  j["pb_moment"] = {{"Mt", c.s.Mt}, {"Mbs", c.s.Mbs}, {"Mbt", c.s.Mbt}};
+  return j;
+}
+
 } // namespace rocklab

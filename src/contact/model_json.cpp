@@ -1,0 +1,92 @@
+#include "contact/model_json.hpp"
+
+#include "io/json_input.hpp"
+
+namespace rocklab {
+
+void read_bond_option(JsonObject& p, bool default_bond, bool& bond, double& lo, double& hi) {
+  bond = default_bond;
+  lo = -1e300;
+  hi = 0;
+  if (!p.has("bond"))
+    return;
+  const auto& v = p.raw("bond");
+  if (v.is_boolean()) {
+    bond = v.get<bool>();
+  } else if (v.is_number()) {
+    bond = true;
+    hi = v.get<double>();
+  } else if (v.is_object() && v.size() == 1 && v.contains("gap") && v["gap"].is_array() &&
+             v["gap"].size() == 2 && v["gap"][0].is_number() && v["gap"][1].is_number() &&
+             v["gap"][0].get<double>() <= v["gap"][1].get<double>()) {
+    bond = true;
+    lo = v["gap"][0].get<double>();
+    hi = v["gap"][1].get<double>();
+  } else {
+    p.fail("bond", "expected true/false, a maximum gap in m, or {\"gap\": [lo, hi]} with "
+                   "lo <= hi, got " +
+                       describe(v));
+  }
+}
+
+std::vector<std::string> model_names(ModelUse use) {
+  std::vector<std::string> names;
+  for_each_model([&]<class M>() {
+    const bool wanted =
+        use == ModelUse::Any || (use == ModelUse::BallFacet && allows_ball_facet<M>()) ||
+        (use == ModelUse::Methods && HasMethods<M>) || (use == ModelUse::Inherit && Inherits<M>);
+    if (wanted)
+      names.emplace_back(M::name);
+  });
+  return names;
+}
+
+ModelKind model_kind_of(std::string_view name) {
+  ModelKind kind{};
+  bool found = false;
+  for_each_model([&]<class M>() {
+    if (M::name == name) {
+      kind = model_kind<M>;
+      found = true;
+    }
+  });
+  if (!found)
+    throw std::invalid_argument("unknown contact model '" + std::string(name) + "'");
+  return kind;
+}
+
+std::vector<std::string> model_methods(ModelKind kind) {
+  return visit_model(kind, []<class M>() {
+    std::vector<std::string> out;
+    if constexpr (HasMethods<M>)
+      for (std::string_view m : M::methods)
+        out.emplace_back(m);
+    return out;
+  });
+}
+
+bool model_inherits(ModelKind kind) {
+  return visit_model(kind, []<class M>() { return Inherits<M>; });
+}
+
+bool model_allows_ball_facet(ModelKind kind) {
+  return visit_model(kind, []<class M>() { return allows_ball_facet<M>(); });
+}
+
+ModelProps read_contact_props(JsonObject& p, std::string_view model, int dim) {
+  return visit_model(model_kind_of(model), [&]<class M>() {
+    ModelProps props(std::in_place_type<typename M::Props>, M::read(p, dim));
+    p.finish();
+    return props;
+  });
+}
+
+nlohmann::json contact_state_json(const ModelBatches& b, ModelKind kind, std::uint32_t slot,
+                                  int dim) {
+  return visit_model(kind, [&]<class M>() {
+    return with_contact<M>(b.of<M>(), slot,
+                           [&](const auto&... c) { return M::state_json(c..., dim); });
+  });
+}
+
+} // namespace rocklab
