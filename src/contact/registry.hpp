@@ -4,6 +4,7 @@
 // functions (a chain of compares the compiler turns into a jump; no virtual call per contact).
 #pragma once
 
+#include "contact/contact_bond.hpp"
 #include "contact/flat_joint.hpp"
 #include "contact/impact_models.hpp"
 #include "contact/linear.hpp"

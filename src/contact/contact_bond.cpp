@@ -1,0 +1,52 @@
+#include "contact/contact_bond.hpp"
+
+#include "io/json_input.hpp"
+
+namespace rocklab {
+
+ContactBond::Contact ContactBond::make(const Props& p, const CreationInfo& ci) {
+  const double gap = ci.gap;
+  Contact c;
+  c.lin.p = linear::make_params(p.linear, ci);
+  c.lin.p.lin_mode = 0; // the bond's normal force is the absolute spring force
+  c.tenf = p.cb_tenf;
+  c.shearf = p.cb_shearf;
+  if (p.bond && gap >= p.bond_gap_lo && gap <= p.bond_gap_hi)
+    c.state = BondState::Bonded;
+  return c;
+}
+
+void ContactBond::update(Contact& c, const ContactKinematics& k, ContactResult& out,
+                         EventSink& events) noexcept {
+  if (c.state != BondState::Bonded) {
+    Linear::update(c.lin, k, out, events);
+    return;
+  }
+  LinearState& s = c.lin.s;
+  const LinearParams& p = c.lin.p;
+  // Bonded: the normal spring carries tension too; shear without slip (section 4.4).
+  s.Fn = p.kn * (k.gap - p.rgap);
+  linear::shear_update(p.ks, p.fric, s.Fn, s.Fss, s.Fst, s.E_slip, s.slip, k, events, false);
+  contactbond::point_bond_break(c.tenf, c.shearf, p.fric, s.Fn, s.Fss, s.Fst, c.state, events,
+                                [&] { return Linear::energy(c.lin).strain; });
+  out = ContactResult{s.Fn, s.Fss, s.Fst, 0, 0, 0};
+}
+
+ContactBond::Props ContactBond::read(JsonObject& p, int) {
+  Props cb;
+  cb.linear = linear::read_props(p, false);
+  cb.cb_tenf = p.number("cb_tenf", Range::non_negative(), 0.0, "N");
+  cb.cb_shearf = p.number("cb_shearf", Range::non_negative(), 0.0, "N");
+  read_bond_option(p, true, cb.bond, cb.bond_gap_lo, cb.bond_gap_hi);
+  return cb;
+}
+
+nlohmann::json ContactBond::state_json(const Contact& cb, int) {
+  nlohmann::json j = linear::state_json(cb.lin.p, cb.lin.s);
+  j["cb_state"] = cb.state;
+  j["cb_tenf"] = cb.tenf;
+  j["cb_shearf"] = cb.shearf;
+  return j;
+}
+
+} // namespace rocklab
