@@ -3,7 +3,7 @@
 // and bad drop protocols.
 #include "helpers.hpp"
 
-#include "contact/impact_models.hpp"
+#include "contact/power_plastic.hpp"
 #include "lab/drop_test.hpp"
 
 #include <nlohmann/json.hpp>

@@ -6,9 +6,10 @@
 
 #include "contact/contact_bond.hpp"
 #include "contact/flat_joint.hpp"
-#include "contact/impact_models.hpp"
+#include "contact/hysteretic.hpp"
 #include "contact/linear.hpp"
 #include "contact/linear_pbond.hpp"
+#include "contact/power_plastic.hpp"
 #include "contact/smooth_joint.hpp"
 
 #include <cstddef>
