@@ -4,6 +4,7 @@
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
+#include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkIntArray.h>
 #include <vtkLongLongArray.h>
@@ -322,8 +323,13 @@ VtkFileInfo read_vtk_info(const std::string& path) {
   info.cells = ds->GetNumberOfCells();
   for (int i = 0; i < ds->GetPointData()->GetNumberOfArrays(); ++i)
     info.point_arrays.emplace_back(ds->GetPointData()->GetArrayName(i));
-  for (int i = 0; i < ds->GetCellData()->GetNumberOfArrays(); ++i)
+  for (int i = 0; i < ds->GetCellData()->GetNumberOfArrays(); ++i) {
+    vtkDataArray* a = ds->GetCellData()->GetArray(i);
     info.cell_arrays.emplace_back(ds->GetCellData()->GetArrayName(i));
+    if (a && a->GetNumberOfComponents() == 1)
+      for (vtkIdType k = 0; k < a->GetNumberOfTuples(); ++k)
+        info.cell_values[info.cell_arrays.back()].push_back(a->GetTuple1(k));
+  }
   return info;
 }
 

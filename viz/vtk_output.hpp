@@ -82,6 +82,7 @@ private:
 struct VtkFileInfo {
   long long points = 0, cells = 0;
   std::vector<std::string> point_arrays, cell_arrays;
+  std::map<std::string, std::vector<double>> cell_values; ///< one-component cell arrays
 };
 VtkFileInfo read_vtk_info(const std::string& path);
 

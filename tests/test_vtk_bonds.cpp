@@ -1,0 +1,88 @@
+// Every bonded contact model's bonds appear in the ParaView bond series (bonds_*.vtp), intact and
+// then broken, with the model's registry index in the "model" cell array.
+#include "helpers.hpp"
+
+#include "contact/model_json.hpp"
+#include "viz/vtk_output.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+using namespace rocklab;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct BondedCase {
+  std::string model;
+  nlohmann::json props; ///< weak enough to break when the grains are pulled apart
+};
+
+// Two touching 2D grains with a bonded contact; grain 2 is pulled away along y at 1 m/s.
+fs::path write_scene(const BondedCase& c) {
+  const nlohmann::json scene = {
+      {"dimension", 2},
+      {"timestep", 1e-7},
+      {"balls",
+       {{{"id", 1}, {"position", {0, 0}}, {"radius", 1e-3}, {"density", 2650}, {"fix", "all"}},
+        {{"id", 2},
+         {"position", {0, 2e-3}},
+         {"radius", 1e-3},
+         {"density", 2650},
+         {"velocity", {0, 1.0}},
+         {"fix", "all"}}}},
+      {"contact_models", {{{"between", "ball-ball"}, {"model", c.model}, {"properties", c.props}}}},
+      {"run", {{"cycles", 1}}}};
+  const fs::path file = test::scratch_root() / ("vtk-bonds-" + c.model + ".json");
+  std::ofstream(file) << scene.dump(1);
+  return file;
+}
+
+VtkFileInfo bonds_of(const Model& m, const std::string& name) {
+  VtkSeries vtk(test::scratch_root() / ("vtk-bonds-" + name));
+  const auto files = vtk.write(take_snapshot(m, {}, 0.0));
+  return read_vtk_info((test::scratch_root() / ("vtk-bonds-" + name) / files[1]).string());
+}
+
+} // namespace
+
+TEST(VtkBonds, EveryBondedModelIsDrawnIntactThenBroken) {
+  const std::vector<BondedCase> cases = {
+      {"linearpbond", {{"kn", 1e6}, {"pb_kn", 1e12}, {"pb_ks", 1e12}, {"pb_ten", 1e6}}},
+      {"flatjoint",
+       {{"fj_Nr", 2}, {"fj_kn", 1e12}, {"fj_ks", 1e12}, {"fj_ten", 1e6}, {"bond", true}}},
+      {"smoothjoint",
+       {{"sj_kn", 1e12}, {"sj_ks", 1e12}, {"sj_ten", 1e6}, {"sj_coh", 1e6}, {"bond", true}}},
+      {"contactbond", {{"kn", 1e6}, {"cb_tenf", 10.0}, {"cb_shearf", 10.0}}},
+      {"hysteretic", {{"hys_knm", 1e6}, {"hys_tenf", 10.0}}},
+  };
+  std::vector<std::string> covered;
+  for (const BondedCase& c : cases) {
+    SCOPED_TRACE(c.model);
+    covered.push_back(c.model);
+    Scene s = load_scene(write_scene(c).string());
+    Model& m = *s.model;
+    m.initialize();
+    m.cycle(1);
+    const double index = static_cast<double>(model_kind_of(c.model));
+    VtkFileInfo v = bonds_of(m, c.model + "-intact");
+    ASSERT_EQ(v.cells, 1);
+    EXPECT_EQ(v.cell_values["model"], std::vector<double>{index});
+    EXPECT_EQ(v.cell_values["bond_state"], std::vector<double>{2.0});
+    EXPECT_EQ(v.cell_values["broken_fraction"], std::vector<double>{0.0});
+    // Pulled apart by a tenth of a radius: the bond breaks; it is still drawn, as broken.
+    m.cycle(1000);
+    v = bonds_of(m, c.model + "-broken");
+    ASSERT_EQ(v.cells, 1);
+    EXPECT_EQ(v.cell_values["bond_state"], std::vector<double>{0.0});
+    EXPECT_EQ(v.cell_values["broken_fraction"], std::vector<double>{1.0});
+  }
+  // Every model with a bond is covered: the others draw nothing.
+  for (const std::string& name : model_names()) {
+    if (std::find(covered.begin(), covered.end(), name) != covered.end())
+      continue;
+    SCOPED_TRACE(name);
+    EXPECT_TRUE(name == "linear" || name == "powerplastic") << "a new model: add its bonded case";
+  }
+}
