@@ -32,16 +32,27 @@ void CrackMonitor::consume(const Model& m, const std::vector<Event>& events) {
 std::string CrackMonitor::csv() const {
   std::string s = "time_s,step,x_m,y_m,z_m,nx,ny,nz,size_m,mode,ball1,ball2,contact,element,gap_m,"
                   "strength_Pa,energy_J\n";
+  auto field = [&s](const std::string& v) {
+    s += v;
+    s += ',';
+  };
   for (const Crack& c : cracks_) {
-    s += format_double(c.time) + "," + std::to_string(c.step);
+    field(format_double(c.time));
+    field(std::to_string(c.step));
     for (int k = 0; k < 3; ++k)
-      s += "," + format_double(c.position[k]);
+      field(format_double(c.position[k]));
     for (int k = 0; k < 3; ++k)
-      s += "," + format_double(c.normal[k]);
-    s += "," + format_double(c.size) + "," + (c.mode == 1 ? "tension" : "shear") + "," +
-         std::to_string(c.ball1) + "," + std::to_string(c.ball2) + "," + std::to_string(c.contact) +
-         "," + std::to_string(c.element) + "," + format_double(c.gap) + "," +
-         format_double(c.strength) + "," + format_double(c.energy) + "\n";
+      field(format_double(c.normal[k]));
+    field(format_double(c.size));
+    field(c.mode == 1 ? "tension" : "shear");
+    field(std::to_string(c.ball1));
+    field(std::to_string(c.ball2));
+    field(std::to_string(c.contact));
+    field(std::to_string(c.element));
+    field(format_double(c.gap));
+    field(format_double(c.strength));
+    s += format_double(c.energy);
+    s += '\n';
   }
   return s;
 }

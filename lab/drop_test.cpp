@@ -115,25 +115,6 @@ struct RockState {
   double ke = 0, ke_rot = 0; ///< kinetic energy, total and rotational [J]
 };
 
-Wall platen(int dim, double extent) {
-  Wall w;
-  w.name = "platen";
-  const double h = 0.5 * extent;
-  if (dim == 2) {
-    Facet f;
-    f.nv = 2;
-    f.v[0] = Vec3(h, 0, 0); // normal (+y) on the rock's side
-    f.v[1] = Vec3(-h, 0, 0);
-    w.facets.push_back(f);
-  } else {
-    Facet a, b;
-    a.v = {Vec3(-h, -h, 0), Vec3(h, -h, 0), Vec3(h, h, 0)};
-    b.v = {Vec3(-h, -h, 0), Vec3(h, h, 0), Vec3(-h, h, 0)};
-    w.facets = {a, b};
-  }
-  return w;
-}
-
 } // namespace
 
 DropResult run_drop(const DropProtocol& p, double speed, double exponent, std::string* history) {
@@ -151,7 +132,7 @@ DropResult run_drop(const DropProtocol& p, double speed, double exponent, std::s
     size = std::max(size, q.position.norm() + q.radius);
     rmin = std::min(rmin, q.radius);
   }
-  m.walls.push_back(platen(dim, 200 * size));
+  m.walls.push_back(plane_wall(dim, "platen", Vec3::Zero(), up, 200 * size));
   ModelRule rule;
   rule.ball_facet = true;
   rule.props = p.contact;

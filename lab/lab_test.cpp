@@ -1,5 +1,6 @@
 #include "lab/lab_test.hpp"
 
+#include "core/servo.hpp"
 #include "io/json_input.hpp"
 #include "io/output_dir.hpp"
 #include "io/results.hpp"
@@ -38,30 +39,10 @@ Vec3 unit(int axis) {
   return e;
 }
 
-// A plane wall through p with normal n (square of side `extent`; 2D: a segment in the xy plane).
-Wall plane_wall(int dim, const std::string& name, const Vec3& p, const Vec3& n, double extent) {
-  Wall w;
-  w.name = name;
-  const double h = 0.5 * extent;
-  Facet f;
-  if (dim == 2) {
-    const Vec3 u(-n.y(), n.x(), 0);
-    f.nv = 2;
-    f.v[0] = p - h * u;
-    f.v[1] = p + h * u;
-    w.facets.push_back(f);
-  } else {
-    const Vec3 u = n.unitOrthogonal(), v = n.cross(u);
-    const Vec3 a = p - h * u - h * v, b = p + h * u - h * v, c = p + h * u + h * v,
-               d = p - h * u + h * v;
-    f.v = {a, b, c};
-    w.facets.push_back(f);
-    f.v = {a, c, d};
-    w.facets.push_back(f);
-  }
-  w.center = p;
-  w.update_bounds();
-  return w;
+// The machine's plane walls keep their own edge direction (n.unitOrthogonal()), so the platens
+// are the same facets as before the wall builder moved to core.
+Wall machine_wall(int dim, const std::string& name, const Vec3& p, const Vec3& n, double extent) {
+  return plane_wall(dim, name, p, n, extent, n.unitOrthogonal());
 }
 
 constexpr double kServoIntegralSteps = 100; ///< integral time of the confining servo [steps]
@@ -364,8 +345,8 @@ void Machine::setup() {
     Vec3 ptop = center_, pbot = center_;
     ptop[axis_] = hi[axis_];
     pbot[axis_] = lo[axis_];
-    top_ = add_wall(plane_wall(dim_, "platen.top", ptop, -e, span));
-    bottom_ = add_wall(plane_wall(dim_, "platen.bottom", pbot, e, span));
+    top_ = add_wall(machine_wall(dim_, "platen.top", ptop, -e, span));
+    bottom_ = add_wall(machine_wall(dim_, "platen.bottom", pbot, e, span));
   }
   if (p_.type == TestType::Triaxial) {
     if (round_) {
@@ -387,7 +368,7 @@ void Machine::setup() {
           pt[d] = side ? hi[d] : lo[d];
           const Vec3 nrm = side ? Vec3(-unit(d)) : unit(d);
           const std::string name = std::string("confinement.") + "xyz"[d] + (side ? "max" : "min");
-          lateral_.push_back(add_wall(plane_wall(dim_, name, pt, nrm, span)));
+          lateral_.push_back(add_wall(machine_wall(dim_, name, pt, nrm, span)));
           lateral_axis_.push_back(d);
           lateral_sign_.push_back(side ? 1.0 : -1.0);
         }
@@ -525,13 +506,11 @@ void Machine::gather_wall_sums() {
 }
 
 double Machine::servo_velocity(std::size_t wall, double target, double area, double stress) const {
-  // Close the stress error in one step (kServoGain A / (sum k dt)), capped at 0.1 % of a mean
-  // grain radius per step. > 0 moves the wall into the specimen. Needs gather_wall_sums().
-  const double ksum = wall_k_[wall];
+  // Close the stress error in one step, capped at 0.1 % of a mean grain radius per step.
+  // Needs gather_wall_sums().
   const double dt = std::max(m_.timestep(), 1e-15);
-  const double vmax = 1e-3 * r_avg_ / dt;
-  const double v = ksum > 0 ? kServoGain * area / (ksum * dt) * (target - stress) : vmax;
-  return std::clamp(v, -vmax, vmax);
+  return rocklab::servo_velocity(kServoGain, area, wall_k_[wall], dt, target - stress,
+                                 1e-3 * r_avg_ / dt);
 }
 
 double Machine::follow_velocity(std::size_t k) const {

@@ -1,5 +1,6 @@
 #include "materials/genesis.hpp"
 
+#include "core/servo.hpp"
 #include "io/json_input.hpp"
 
 #include <algorithm>
@@ -30,35 +31,6 @@ double normal(std::mt19937_64& rng, const Distribution& d) {
 
 double grain_volume(int dim, double r) {
   return dim == 2 ? kPi * r * r : 4.0 / 3.0 * kPi * r * r * r;
-}
-
-Facet facet(std::initializer_list<Vec3> pts) {
-  Facet f;
-  f.nv = static_cast<int>(pts.size());
-  int k = 0;
-  for (const Vec3& p : pts)
-    f.v[k++] = p;
-  return f;
-}
-
-// A plane wall through p with inward normal n (square of side `extent`; 2D: a segment).
-Wall plane(int dim, const std::string& name, const Vec3& p, const Vec3& n, double extent) {
-  Wall w;
-  w.name = name;
-  const double h = 0.5 * extent;
-  if (dim == 2) {
-    const Vec3 u(-n.y(), n.x(), 0);
-    w.facets.push_back(facet({p - h * u, p + h * u}));
-  } else {
-    const Vec3 g = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-    const Vec3 u = (g - g.dot(n) * n).normalized(), v = n.cross(u);
-    const Vec3 a = p - h * u - h * v, b = p + h * u - h * v, c = p + h * u + h * v,
-               d = p - h * u + h * v;
-    w.facets = {facet({a, b, c}), facet({a, c, d})};
-  }
-  w.center = p;
-  w.update_bounds();
-  return w;
 }
 
 // A circular (2D) or cylindrical (3D, axis z, unbounded along it) wall of radius r.
@@ -152,7 +124,7 @@ Vessel make_vessel(Model& m, const MaterialCard& card, double scale) {
   const Vec3 L = card.vessel.size * scale;
   const double big = 1.5 * L.maxCoeff();
   auto add_plane = [&](const std::string& name, const Vec3& p, const Vec3& n) {
-    m.walls.push_back(plane(card.dim, name, p, n, big));
+    m.walls.push_back(plane_wall(card.dim, name, p, n, big));
     v.servos.push_back({m.walls.size() - 1, n, false});
   };
   switch (card.vessel.shape) {
@@ -425,20 +397,15 @@ GenesisResult run_genesis(const MaterialCard& card,
   double largest_half = 0;
   for (const Servo& s : vessel.servos)
     largest_half = std::max(largest_half, vessel.half_extent(m, s));
-  double speed_cap = 0.01; // largest wall displacement per step / mean radius
+  double speed_cap = 0.01;  // largest wall displacement per step / mean radius
+  std::vector<double> ksum; // reused by every servo step
   auto servo_step = [&](double target) {
-    std::vector<double> ksum(m.walls.size(), 0.0);
-    for (std::size_t ci = 0; ci < m.contacts().size(); ++ci)
-      if (m.contacts()[ci].kind == ContactKind::BallFacet)
-        ksum[static_cast<std::size_t>(m.contacts()[ci].end2)] +=
-            m.contact_outputs()[ci].stiff.k_tran;
+    wall_stiffness_sums(m, ksum);
     const double dt = std::max(m.timestep(), 1e-12);
     for (const Servo& s : vessel.servos) {
       const double vmax = speed_cap * r_avg / dt * vessel.half_extent(m, s) / largest_half;
-      const double err = target - vessel.stress(m, s); // > 0: push in
-      const double A = vessel.area(m, s);
-      double v = ksum[s.wall] > 0 ? 0.5 * A / (ksum[s.wall] * dt) * err : vmax;
-      v = std::clamp(v, -vmax, vmax);
+      const double v = servo_velocity(0.5, vessel.area(m, s), ksum[s.wall], dt,
+                                      target - vessel.stress(m, s), vmax);
       Wall& w = m.walls[s.wall];
       if (s.radial)
         w.radial_velocity = -v;

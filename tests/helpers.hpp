@@ -36,31 +36,9 @@ inline ::testing::AssertionResult near_rel(double a, double b, double rel, doubl
 }
 
 /// A square plane wall (3D) or a segment (2D) through p with normal n.
-inline Wall plane_wall(int dim, const Vec3& p, const Vec3& n_in, double extent,
+inline Wall plane_wall(int dim, const Vec3& p, const Vec3& n, double extent,
                        const std::string& name = "plane") {
-  const Vec3 n = n_in.normalized();
-  Wall w;
-  w.name = name;
-  const double h = 0.5 * extent;
-  if (dim == 2) {
-    const Vec3 u(-n.y(), n.x(), 0);
-    Facet f;
-    f.nv = 2;
-    f.v[0] = p - h * u;
-    f.v[1] = p + h * u;
-    w.facets.push_back(f);
-  } else {
-    const Vec3 g = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-    const Vec3 u = (g - g.dot(n) * n).normalized();
-    const Vec3 v = n.cross(u);
-    Facet a, b;
-    a.v = {p - h * u - h * v, p + h * u - h * v, p + h * u + h * v};
-    b.v = {p - h * u - h * v, p + h * u + h * v, p - h * u + h * v};
-    w.facets = {a, b};
-  }
-  w.center = p;
-  w.update_bounds();
-  return w;
+  return rocklab::plane_wall(dim, name, p, n.normalized(), extent);
 }
 
 inline ModelRule linear_rule(bool ball_facet, LinearProps p) {

@@ -18,6 +18,10 @@
 
 namespace rocklab {
 
+namespace detail {
+struct CellGrid;
+}
+
 /// A physical blow-up (NaN, overlap beyond a radius): the run cannot continue.
 struct PhysicsError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -134,9 +138,23 @@ private:
   void share_contact_energy(const Contact& c, const ContactEnergy& e,
                             std::vector<EnergyLedger>& out) const;
   void compact_contacts(const std::function<bool(Contact&)>& keep);
+  // detection.cpp
   void detect();
+  detail::CellGrid bin_balls();
+  void gather_candidates(const detail::CellGrid& grid);
+  void merge_candidates();
+  void retire_contact(std::size_t ci);
+  void create_contact(std::uint64_t key);
+  // forces.cpp
   void force_displacement(double dt_increment);
+  bool update_contact_force(std::size_t ci, double dt, EventBuffer& events);
+  void book_events(std::size_t first);
+  double sum_ball_forces();
+  void sum_wall_forces();
+  [[noreturn]] void throw_overlap_blowup(std::size_t ci) const;
+  // motion.cpp
   void law_of_motion(double dt);
+  void track_motion(double dt);
   double estimate_timestep() const;
   bool needs_detection() const;
 

@@ -1,9 +1,43 @@
 #include "core/walls.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace rocklab {
+
+Wall plane_wall(int dim, const std::string& name, const Vec3& p, const Vec3& n, double extent,
+                const std::optional<Vec3>& edge) {
+  Wall w;
+  w.name = name;
+  const double h = 0.5 * extent;
+  Facet f;
+  if (dim == 2) {
+    const Vec3 u(-n.y(), n.x(), 0);
+    f.nv = 2;
+    f.v[0] = p - h * u;
+    f.v[1] = p + h * u;
+    w.facets.push_back(f);
+  } else {
+    Vec3 u;
+    if (edge) {
+      u = *edge;
+    } else {
+      const Vec3 g = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+      u = (g - g.dot(n) * n).normalized();
+    }
+    const Vec3 v = n.cross(u);
+    const Vec3 a = p - h * u - h * v, b = p + h * u - h * v, c = p + h * u + h * v,
+               d = p - h * u + h * v;
+    f.v = {a, b, c};
+    w.facets.push_back(f);
+    f.v = {a, c, d};
+    w.facets.push_back(f);
+  }
+  w.center = p;
+  w.update_bounds();
+  return w;
+}
 
 void Wall::update_bounds() {
   if (is_cylinder()) {

@@ -4,6 +4,7 @@
 #include "core/types.hpp"
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,13 @@ struct Wall {
     return n > 0 ? Vec3(r / n) : Vec3::Zero();
   }
 };
+
+/// A square plane wall of side `extent` through p with unit normal n, centred on p (3D: two
+/// triangles; 2D: a segment in the xy plane; balls touch it from either side). In 3D the square's
+/// edges run along `edge` and n x edge; by default `edge` is the x axis projected onto the plane
+/// (the y axis when n is near x).
+Wall plane_wall(int dim, const std::string& name, const Vec3& p, const Vec3& n, double extent,
+                const std::optional<Vec3>& edge = std::nullopt);
 
 /// Closest point of a facet to p.
 Vec3 closest_point_on_facet(const Facet& f, const Vec3& p);

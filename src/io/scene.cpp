@@ -78,21 +78,6 @@ Facet make_facet(const std::vector<Vec3>& pts) {
   return f;
 }
 
-// A square (3D, two triangles) or segment (2D) of side `extent` centred on p, normal n.
-std::vector<Facet> plane_facets(int dim, const Vec3& p, const Vec3& n, double extent) {
-  const double h = 0.5 * extent;
-  if (dim == 2) {
-    const Vec3 u(-n.y(), n.x(), 0);
-    return {make_facet({p - h * u, p + h * u})};
-  }
-  const Vec3 g = std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
-  const Vec3 u = (g - g.dot(n) * n).normalized();
-  const Vec3 v = n.cross(u);
-  const Vec3 a = p - h * u - h * v, b = p + h * u - h * v, c = p + h * u + h * v,
-             d = p - h * u + h * v;
-  return {make_facet({a, b, c}), make_facet({a, c, d})};
-}
-
 void read_walls(JsonObject& top, Model& m) {
   const int dim = m.settings.dim;
   for (const auto& [jw, path] : top.array("walls", false)) {
@@ -133,7 +118,7 @@ void read_walls(JsonObject& top, Model& m) {
       p.finish();
       Wall w;
       w.name = name;
-      w.facets = plane_facets(dim, point, n, extent);
+      w.facets = plane_wall(dim, name, point, n, extent).facets;
       made.push_back(std::move(w));
     } else {
       JsonObject b = o.object("box");
@@ -154,7 +139,7 @@ void read_walls(JsonObject& top, Model& m) {
           const double extent = 1.2 * size.maxCoeff();
           Wall w;
           w.name = name + "." + axis[d] + (side ? "max" : "min");
-          w.facets = plane_facets(dim, p, n, extent);
+          w.facets = plane_wall(dim, w.name, p, n, extent).facets;
           made.push_back(std::move(w));
         }
     }
