@@ -2,26 +2,14 @@
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"
+#include "lab/protocol_table.hpp"
+#include "lab/protocols/frame_test.hpp"
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 namespace rocklab {
-
-const char* test_type_name(TestType t) {
-  switch (t) {
-  case TestType::Ucs:
-    return "ucs";
-  case TestType::Triaxial:
-    return "triaxial";
-  case TestType::Brazilian:
-    return "brazilian";
-  case TestType::DirectTension:
-    return "direct_tension";
-  }
-  return "unknown";
-}
 
 namespace {
 
@@ -45,11 +33,8 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     top.fail("units", "only \"SI\" is supported");
   p.name = top.string("name", "");
   top.string("description", "");
-  const std::string type = top.choice("test", {"ucs", "triaxial", "brazilian", "direct_tension"});
-  p.type = type == "ucs"         ? TestType::Ucs
-           : type == "triaxial"  ? TestType::Triaxial
-           : type == "brazilian" ? TestType::Brazilian
-                                 : TestType::DirectTension;
+  p.test = top.choice("test", frame_test_names());
+  const std::unique_ptr<FrameTest> test = make_frame_test(p.test);
   {
     if (!top.has("specimen"))
       top.fail("specimen", "missing: give {\"file\": SPECIMEN} or {\"material\": CARD}");
@@ -88,10 +73,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     p.confinement_tolerance = l.number("confinement_tolerance", {0, 0.5, true, false}, 0.01);
     p.grip_fraction = l.number("grip_fraction", {0, 0.4, true, false}, 0.1);
     p.reverse_at_strain = l.number("reverse_at_strain", {0, 0.1, false, false}, 0.0);
-    if (p.type == TestType::Triaxial && !(p.confinement > 0))
-      l.fail("confinement", "a triaxial test needs a confining stress > 0 Pa");
-    if (p.type != TestType::Triaxial && p.confinement > 0)
-      l.fail("confinement", "only a triaxial test is confined (use \"test\": \"triaxial\")");
+    test->check_loading(l, p);
     l.finish();
   }
   {
@@ -101,9 +83,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     p.strain_limit = s.number("strain_limit", Range::non_negative(), 0.0);
     p.split_fraction = s.number("split_fraction", {0, 1, true, true}, 0.6);
     p.failed_fraction = s.number("failed_fraction", {0, 1, true, false}, 0.3);
-    if (p.type != TestType::Brazilian && (s.has("split_fraction") || s.has("failed_fraction")))
-      s.fail(s.has("split_fraction") ? "split_fraction" : "failed_fraction",
-             "applies to Brazilian tests only");
+    test->check_stop(s);
     if (p.failed_fraction >= p.post_peak_fraction)
       s.fail("failed_fraction",
              "must be below stop.post_peak_fraction (" + format_double(p.post_peak_fraction) + ")");

@@ -1,5 +1,6 @@
-// Protocol files: what laboratory test to run on which specimen, how fast, when to stop and what
-// to write (docs/protocol-format.md). All quantities SI.
+// Protocol files of tests in the loading frame: what test to run on which specimen, how fast, when
+// to stop and what to write (docs/protocol-format.md). The test's own rules for its keys come
+// from its protocol (lab/protocols/). All quantities SI.
 #pragma once
 
 #include "materials/material_card.hpp"
@@ -11,17 +12,13 @@
 
 namespace rocklab {
 
-enum class TestType { Ucs, Triaxial, Brazilian, DirectTension };
-
-const char* test_type_name(TestType t);
-
 /// Default loading rate: the quasi-static rate of docs/results.md (strain rate, 1/s).
 inline constexpr double kDefaultStrainRate = 1.0;
 
 struct Protocol {
   std::string file; ///< the protocol file (paths inside it are relative to its folder)
   std::string name;
-  TestType type = TestType::Ucs;
+  std::string test = "ucs"; ///< the test's name in lab/protocol_table.cpp
   // specimen: a specimen file, or a material card run through genesis first
   std::string specimen_file;
   std::string material_file;
@@ -55,7 +52,8 @@ struct Protocol {
   std::string text_hash;            ///< hash of the file's text
 };
 
-/// Read and validate a protocol file; errors name the file, key, value and allowed range.
+/// Read and validate a protocol file of a test in the loading frame; errors name the file, key,
+/// value and allowed range.
 Protocol load_protocol(const std::string& path);
 /// Read a protocol from JSON (suites embed them); `file` locates relative paths and errors.
 Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,

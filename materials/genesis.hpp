@@ -37,6 +37,11 @@ struct GenesisResult {
   GenesisReport report;
 };
 
+/// The metadata a specimen file made by genesis carries: rocklab version, the material card
+/// (file, name, hash, its JSON), the seed and the genesis report (without its wall time, so the
+/// specimen's bytes depend only on the inputs).
+nlohmann::json specimen_meta(const MaterialCard& card, const GenesisReport& report);
+
 /// Run material genesis. Throws PhysicsError on blow-up and std::runtime_error when a phase does
 /// not reach its criterion within the card's max_cycles.
 /// `interrupt` (optional) is polled between chunks of cycles; when set, genesis throws.

@@ -126,6 +126,15 @@ ShapeSpec shape_from_json(const nlohmann::json& j, int dim, const std::string& f
   return read_shape(JsonObject(j, file, key), dim);
 }
 
+void apply_overrides(MaterialCard& card, const GenesisOverrides& o) {
+  if (!o.shape.value.is_null())
+    card.vessel = shape_from_json(o.shape.value, card.dim, o.shape.file, o.shape.key);
+  if (!o.cut.value.is_null())
+    card.cut = shape_from_json(o.cut.value, card.dim, o.cut.file, o.cut.key);
+  if (o.seed)
+    card.seed = *o.seed;
+}
+
 namespace {
 
 LinearProps read_linear(JsonObject o) {
@@ -142,110 +151,79 @@ LinearProps read_linear(JsonObject o) {
   return p;
 }
 
-} // namespace
-
-MaterialCard load_material_card(const std::string& path) {
-  MaterialCard c;
-  c.file = path;
-  {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    c.text_hash = text_hash(ss.str());
-  }
-  c.raw = read_json_file(path);
-  JsonObject top(c.raw, path, "");
-  if (top.has("units") && top.string("units") != "SI")
-    top.fail("units", "only \"SI\" is supported");
-  c.name = top.string("name");
-  c.source = top.string("source", "");
-  top.string("description", "");
-  c.dim = static_cast<int>(top.integer("dimension", 2, 3));
-  c.density = top.number("density", Range::positive(), std::nullopt, "kg/m^3");
-  c.seed = static_cast<std::uint64_t>(
-      top.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), 1));
-  {
-    JsonObject g = top.object("grains");
-    if (g.has("radius") == g.has("sieve"))
-      top.fail("grains", "give exactly one of 'radius' [R_min, R_max] or 'sieve'");
-    if (g.has("radius")) {
-      const auto& r = g.raw("radius");
-      if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number())
-        g.fail("radius", "expected [R_min, R_max] in m, got " + describe(r));
-      c.r_min = r[0].get<double>();
-      c.r_max = r[1].get<double>();
-      if (!(c.r_min > 0))
-        g.fail("radius", "R_min = " + r[0].dump() + " is out of range (0, +inf) m");
-      if (c.r_min > c.r_max)
-        g.fail("radius", "R_min = " + r[0].dump() + " exceeds R_max = " + r[1].dump());
-    } else {
-      const auto& sv = g.raw("sieve");
-      if (!sv.is_array() || sv.size() < 2)
-        g.fail("sieve", "expected at least two [diameter m, fraction passing] pairs");
-      double last_d = 0, last_f = 0;
-      for (const auto& e : sv) {
-        if (!e.is_array() || e.size() != 2 || !e[0].is_number() || !e[1].is_number())
-          g.fail("sieve", "expected [diameter m, fraction passing] pairs, got " + describe(e));
-        const double d = e[0].get<double>(), f = e[1].get<double>();
-        if (!(d > last_d) || f < last_f || f > 1)
-          g.fail("sieve", "diameters must increase and fractions passing rise within [0, 1]");
-        c.sieve.emplace_back(d, f);
-        last_d = d;
-        last_f = f;
-      }
-      if (c.sieve.front().second != 0 || c.sieve.back().second != 1)
-        g.fail("sieve", "the curve must start at fraction 0 and end at fraction 1");
-      c.r_min = 0.5 * c.sieve.front().first;
-      c.r_max = 0.5 * c.sieve.back().first;
+void read_grains(JsonObject& top, MaterialCard& c) {
+  JsonObject g = top.object("grains");
+  if (g.has("radius") == g.has("sieve"))
+    top.fail("grains", "give exactly one of 'radius' [R_min, R_max] or 'sieve'");
+  if (g.has("radius")) {
+    const auto& r = g.raw("radius");
+    if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number())
+      g.fail("radius", "expected [R_min, R_max] in m, got " + describe(r));
+    c.r_min = r[0].get<double>();
+    c.r_max = r[1].get<double>();
+    if (!(c.r_min > 0))
+      g.fail("radius", "R_min = " + r[0].dump() + " is out of range (0, +inf) m");
+    if (c.r_min > c.r_max)
+      g.fail("radius", "R_min = " + r[0].dump() + " exceeds R_max = " + r[1].dump());
+  } else {
+    const auto& sv = g.raw("sieve");
+    if (!sv.is_array() || sv.size() < 2)
+      g.fail("sieve", "expected at least two [diameter m, fraction passing] pairs");
+    double last_d = 0, last_f = 0;
+    for (const auto& e : sv) {
+      if (!e.is_array() || e.size() != 2 || !e[0].is_number() || !e[1].is_number())
+        g.fail("sieve", "expected [diameter m, fraction passing] pairs, got " + describe(e));
+      const double d = e[0].get<double>(), f = e[1].get<double>();
+      if (!(d > last_d) || f < last_f || f > 1)
+        g.fail("sieve", "diameters must increase and fractions passing rise within [0, 1]");
+      c.sieve.emplace_back(d, f);
+      last_d = d;
+      last_f = f;
     }
-    g.finish();
+    if (c.sieve.front().second != 0 || c.sieve.back().second != 1)
+      g.fail("sieve", "the curve must start at fraction 0 and end at fraction 1");
+    c.r_min = 0.5 * c.sieve.front().first;
+    c.r_max = 0.5 * c.sieve.back().first;
   }
-  c.porosity = top.number("porosity", {0, 1, true, true}, std::nullopt);
-  c.vessel = read_shape(top.object("specimen"), c.dim);
-  if (top.has("cut"))
-    c.cut = read_shape(top.object("cut"), c.dim);
-  if (top.has("clumps")) {
-    JsonObject k = top.object("clumps");
-    c.clump_max = static_cast<int>(k.integer("max_pebbles", 2, 8));
-    if (c.cut)
-      k.fail("max_pebbles", "clumped grains cannot be cut from a block (a cut would split "
-                            "clumps); leave out 'cut'");
-    k.finish();
-  }
-  {
-    JsonObject p = top.optional_object("packing");
-    c.packing_method = p.choice("method", {"contraction", "scaling"}, "contraction") == "scaling"
-                           ? MaterialCard::Packing::Scaling
-                           : MaterialCard::Packing::Contraction;
-    c.packing_friction = p.number("friction", Range::non_negative(), 0.5);
-    c.porosity_tolerance = p.number("porosity_tolerance", {0, 0.1, true, false}, 0.003);
-    c.compaction_strain = p.number("compaction_strain", {0, 0.01, true, false}, 5e-4);
-    c.cloud_porosity = p.number("cloud_porosity", {0, 1, true, true},
-                                std::min(c.porosity + 0.1, 0.5 * (1 + c.porosity)));
-    if (c.cloud_porosity <= c.porosity)
-      p.fail("cloud_porosity", "must exceed the target porosity " + std::to_string(c.porosity));
-    c.max_overlap_ratio = p.number("max_overlap_ratio", Range::positive(), 0.25);
-    c.equilibrium_ratio = p.number("equilibrium_ratio", Range::positive(), 5e-3);
-    c.max_cycles =
-        p.integer("max_cycles", 1000, std::numeric_limits<std::int64_t>::max(), 2'000'000);
-    c.eliminate_floaters = p.boolean("eliminate_floaters", false);
-    p.finish();
-  }
-  {
-    JsonObject i = top.optional_object("installation");
-    c.pressure = i.number("pressure", Range::positive(), 1e5, "Pa");
-    c.pressure_tolerance = i.number("pressure_tolerance", {0, 1, true, true}, 0.02);
-    if (i.has("gap") && i.has("gap_ratio"))
-      i.fail("gap", "give either 'gap' (m) or 'gap_ratio' (g_i / R_avg), not both");
-    if (i.has("gap_ratio"))
-      c.install_gap =
-          i.number("gap_ratio", Range::non_negative(), std::nullopt) * 0.5 * (c.r_min + c.r_max);
-    else
-      c.install_gap = i.number("gap", Range::non_negative(), 0.0, "m");
-    c.residual_tolerance = i.number("residual_tolerance", Range::positive(), 0.05);
-    i.finish();
-  }
-  c.linear = read_linear(top.object("linear"));
+  g.finish();
+}
+
+void read_packing(JsonObject& top, MaterialCard& c) {
+  JsonObject p = top.optional_object("packing");
+  c.packing_method = p.choice("method", {"contraction", "scaling"}, "contraction") == "scaling"
+                         ? MaterialCard::Packing::Scaling
+                         : MaterialCard::Packing::Contraction;
+  c.packing_friction = p.number("friction", Range::non_negative(), 0.5);
+  c.porosity_tolerance = p.number("porosity_tolerance", {0, 0.1, true, false}, 0.003);
+  c.compaction_strain = p.number("compaction_strain", {0, 0.01, true, false}, 5e-4);
+  c.cloud_porosity = p.number("cloud_porosity", {0, 1, true, true},
+                              std::min(c.porosity + 0.1, 0.5 * (1 + c.porosity)));
+  if (c.cloud_porosity <= c.porosity)
+    p.fail("cloud_porosity", "must exceed the target porosity " + std::to_string(c.porosity));
+  c.max_overlap_ratio = p.number("max_overlap_ratio", Range::positive(), 0.25);
+  c.equilibrium_ratio = p.number("equilibrium_ratio", Range::positive(), 5e-3);
+  c.max_cycles = p.integer("max_cycles", 1000, std::numeric_limits<std::int64_t>::max(), 2'000'000);
+  c.eliminate_floaters = p.boolean("eliminate_floaters", false);
+  p.finish();
+}
+
+void read_installation(JsonObject& top, MaterialCard& c) {
+  JsonObject i = top.optional_object("installation");
+  c.pressure = i.number("pressure", Range::positive(), 1e5, "Pa");
+  c.pressure_tolerance = i.number("pressure_tolerance", {0, 1, true, true}, 0.02);
+  if (i.has("gap") && i.has("gap_ratio"))
+    i.fail("gap", "give either 'gap' (m) or 'gap_ratio' (g_i / R_avg), not both");
+  if (i.has("gap_ratio"))
+    c.install_gap =
+        i.number("gap_ratio", Range::non_negative(), std::nullopt) * 0.5 * (c.r_min + c.r_max);
+  else
+    c.install_gap = i.number("gap", Range::non_negative(), 0.0, "m");
+  c.residual_tolerance = i.number("residual_tolerance", Range::positive(), 0.05);
+  i.finish();
+}
+
+// The bonded model of the card: flat joints, parallel bonds, contact bonds or none.
+void read_bonding(JsonObject& top, MaterialCard& c) {
   const int bonds = top.has("flatjoint") + top.has("parallelbond") + top.has("contactbond");
   if (bonds > 1)
     top.fail("flatjoint", "give one of 'flatjoint', 'parallelbond' or 'contactbond'");
@@ -295,6 +273,9 @@ MaterialCard load_material_card(const std::string& path) {
   } else {
     c.bonding = MaterialCard::Bonding::None;
   }
+}
+
+void read_joints(JsonObject& top, MaterialCard& c, const std::string& path) {
   for (const auto& [jj, jpath] : top.array("joints", false)) {
     JsonObject j(*jj, path, jpath);
     JointSpec js;
@@ -316,6 +297,48 @@ MaterialCard load_material_card(const std::string& path) {
     j.finish();
     c.joints.push_back(js);
   }
+}
+
+} // namespace
+
+MaterialCard load_material_card(const std::string& path) {
+  MaterialCard c;
+  c.file = path;
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    c.text_hash = text_hash(ss.str());
+  }
+  c.raw = read_json_file(path);
+  JsonObject top(c.raw, path, "");
+  if (top.has("units") && top.string("units") != "SI")
+    top.fail("units", "only \"SI\" is supported");
+  c.name = top.string("name");
+  c.source = top.string("source", "");
+  top.string("description", "");
+  c.dim = static_cast<int>(top.integer("dimension", 2, 3));
+  c.density = top.number("density", Range::positive(), std::nullopt, "kg/m^3");
+  c.seed = static_cast<std::uint64_t>(
+      top.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), 1));
+  read_grains(top, c);
+  c.porosity = top.number("porosity", {0, 1, true, true}, std::nullopt);
+  c.vessel = read_shape(top.object("specimen"), c.dim);
+  if (top.has("cut"))
+    c.cut = read_shape(top.object("cut"), c.dim);
+  if (top.has("clumps")) {
+    JsonObject k = top.object("clumps");
+    c.clump_max = static_cast<int>(k.integer("max_pebbles", 2, 8));
+    if (c.cut)
+      k.fail("max_pebbles", "clumped grains cannot be cut from a block (a cut would split "
+                            "clumps); leave out 'cut'");
+    k.finish();
+  }
+  read_packing(top, c);
+  read_installation(top, c);
+  c.linear = read_linear(top.object("linear"));
+  read_bonding(top, c);
+  read_joints(top, c, path);
   top.finish();
   return c;
 }

@@ -89,6 +89,23 @@ ShapeSpec shape_from_json(const nlohmann::json& j, int dim, const std::string& f
 /// Read and validate a material card; errors name the file, key, value and allowed range.
 MaterialCard load_material_card(const std::string& path);
 
+/// A JSON value given somewhere else than the card, with where it was given (for errors).
+struct JsonAt {
+  nlohmann::json value; ///< null: not given
+  std::string file, key;
+};
+
+/// What a command line (`rocklab genesis --shape/--cut/--seed`) or a protocol's specimen changes
+/// of a card before genesis.
+struct GenesisOverrides {
+  JsonAt shape;                      ///< replaces the specimen shape (the card's form)
+  JsonAt cut;                        ///< replaces the cut (a test shape cut from the block)
+  std::optional<std::uint64_t> seed; ///< replaces the random seed
+};
+
+/// Apply the overrides to a card; a bad shape fails naming where it was given.
+void apply_overrides(MaterialCard& card, const GenesisOverrides& o);
+
 /// FNV-1a 64-bit hash of a text, as 16 hex digits (stable across platforms).
 std::string text_hash(const std::string& text);
 

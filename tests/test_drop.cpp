@@ -4,7 +4,7 @@
 #include "helpers.hpp"
 
 #include "contact/power_plastic.hpp"
-#include "lab/drop_test.hpp"
+#include "lab/protocols/drop.hpp"
 
 #include <nlohmann/json.hpp>
 

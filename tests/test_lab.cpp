@@ -4,7 +4,7 @@
 
 #include "io/json_input.hpp"
 #include "io/specimen.hpp"
-#include "lab/lab_test.hpp"
+#include "lab/run_test.hpp"
 #include "lab/suite.hpp"
 #include "viz/vtk_output.hpp"
 

@@ -4,8 +4,7 @@
 #include "io/scene.hpp"
 #include "io/scene_run.hpp"
 #include "io/specimen.hpp"
-#include "lab/drop_test.hpp"
-#include "lab/lab_test.hpp"
+#include "lab/protocol_table.hpp"
 #include "lab/suite.hpp"
 #include "materials/genesis.hpp"
 
@@ -57,26 +56,27 @@ int run_command(const std::string& scene_file, const std::string& out_dir, bool 
   return 0;
 }
 
-// A shape given on the command line as JSON text (genesis --shape / --cut).
-rocklab::ShapeSpec shape_option(const std::string& text, int dim, const std::string& option) {
-  nlohmann::json j;
+// A shape given on the command line as JSON text (genesis --shape / --cut); null if not given.
+rocklab::JsonAt shape_option(const std::string& text, const std::string& option) {
+  rocklab::JsonAt at{nullptr, option, option.substr(2)};
+  if (text.empty())
+    return at;
   try {
-    j = nlohmann::json::parse(text);
+    at.value = nlohmann::json::parse(text);
   } catch (const std::exception& e) {
     throw rocklab::InputError(option + ": not JSON: " + std::string(e.what()));
   }
-  return rocklab::shape_from_json(j, dim, option, option.substr(2));
+  return at;
 }
 
 int genesis_command(const std::string& material_file, const std::string& out, bool quiet,
                     const std::string& shape, const std::string& cut, std::int64_t seed) {
   rocklab::MaterialCard card = rocklab::load_material_card(material_file);
-  if (!shape.empty())
-    card.vessel = shape_option(shape, card.dim, "--shape");
-  if (!cut.empty())
-    card.cut = shape_option(cut, card.dim, "--cut");
+  rocklab::GenesisOverrides overrides{shape_option(shape, "--shape"), shape_option(cut, "--cut"),
+                                      std::nullopt};
   if (seed >= 0)
-    card.seed = static_cast<std::uint64_t>(seed);
+    overrides.seed = static_cast<std::uint64_t>(seed);
+  rocklab::apply_overrides(card, overrides);
   const bool tty = !quiet && ::isatty(STDERR_FILENO);
   rocklab::GenesisResult g = rocklab::run_genesis(
       card,
@@ -88,15 +88,7 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
   if (g_interrupt.load())
     throw std::runtime_error("interrupted; no specimen was written");
   const nlohmann::json report = g.report.to_json();
-  nlohmann::json report_in_specimen = report;
-  report_in_specimen.erase("seconds"); // the specimen's bytes depend only on the inputs
-  const nlohmann::json meta{{"rocklab_version", ROCKLAB_VERSION},
-                            {"material_file", material_file},
-                            {"material_name", card.name},
-                            {"material_hash", card.text_hash},
-                            {"seed", card.seed},
-                            {"material", card.raw},
-                            {"report", report_in_specimen}};
+  const nlohmann::json meta = rocklab::specimen_meta(card, g.report);
   // The report first (atomically), then the specimen: a specimen never lacks its report.
   const std::string report_file = out + ".report.json";
   rocklab::write_text_file(report_file + ".partial", report.dump(1) + "\n");
@@ -138,97 +130,17 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
   return 0;
 }
 
-void print_lab_results(const rocklab::LabSummary& s, const std::string& out_dir) {
-  const nlohmann::json& r = s.results;
-  auto mpa = [&](const char* key) { return r.contains(key) ? r[key].get<double>() * 1e-6 : 0.0; };
-  std::printf("test         %s   material %s   grains %lld   steps %lld\n",
-              r["test"].get<std::string>().c_str(),
-              r["provenance"]["material"].get<std::string>().c_str(),
-              static_cast<long long>(r["provenance"]["grains"].get<std::int64_t>()),
-              static_cast<long long>(r["provenance"]["steps"].get<std::int64_t>()));
-  if (r.contains("peak_stress_Pa")) {
-    std::printf("peak stress  %.4g MPa (deviator %.4g MPa) at axial strain %.4g %%\n",
-                mpa("peak_stress_Pa"), mpa("peak_deviator_Pa"),
-                100 * r["peak_axial_strain"].get<double>());
-    std::printf("E            %.4g GPa tangent at 50 %% of peak, %.4g GPa secant   poisson %.3f\n",
-                1e-3 * mpa("youngs_modulus_Pa"), 1e-3 * mpa("youngs_modulus_secant_Pa"),
-                r["poisson_ratio"].get<double>());
-    if (r.value("confinement_Pa", 0.0) > 0)
-      std::printf("confinement  %.4g MPa (held between %.4g and %.4g MPa)\n", mpa("confinement_Pa"),
-                  1e-6 * r["confinement_measured_Pa"]["min"].get<double>(),
-                  1e-6 * r["confinement_measured_Pa"]["max"].get<double>());
-  }
-  if (r.contains("tensile_strength_Pa"))
-    std::printf("tensile strength %.4g MPa (peak force %.4g N)\n", mpa("tensile_strength_Pa"),
-                r["peak_force_N"].get<double>());
-  const auto& c = r["cracks"];
-  std::printf("cracks       %lld tension, %lld shear (%lld at peak)\n",
-              static_cast<long long>(c["tension"].get<std::int64_t>()),
-              static_cast<long long>(c["shear"].get<std::int64_t>()),
-              static_cast<long long>(c["at_peak"]["total"].get<std::int64_t>()));
-  std::printf("stopped      %s\n", r["stop_reason"].get<std::string>().c_str());
-  std::printf("wall time    %.1f s on %d thread(s)\n", s.wall_seconds, omp_get_max_threads());
-  std::printf("results      %s/results.json  %s/history.csv  %s/cracks.csv\n", out_dir.c_str(),
-              out_dir.c_str(), out_dir.c_str());
-  for (const auto& f : r["files"]) {
-    const std::string name = f.get<std::string>();
-    if (name.ends_with(".svg"))
-      std::printf("plot         %s/%s\n", out_dir.c_str(), name.c_str());
-    else if (name == "vtk/grains.pvd")
-      std::printf("ParaView     %s/vtk/grains.pvd (also bonds.pvd, cracks.pvd, walls.pvd; "
-                  "viz/rocklab_paraview.py sets up the view)\n",
-                  out_dir.c_str());
-  }
-}
-
-void print_drop_results(const nlohmann::json& r, const std::string& out_dir) {
-  std::printf("drop test   rock %.4g kg%s, contact %s (units SI)\n",
-              r["rock"]["mass_kg"].get<double>(),
-              r["rock"]["dimension"].get<int>() == 2 ? " per m thickness" : "",
-              r["contact_model"].get<std::string>().c_str());
-  std::printf("%8s %10s %10s %8s %8s %10s %10s %8s\n", "v [m/s]", "v_in", "v_out_n", "e_v", "e_E",
-              "spin", "plastic[J]", "b");
-  for (const auto& d : r["drops"])
-    std::printf("%8.3g %10.4g %10.4g %8.4f %8.4f %10.4g %10.4g %8.4g\n",
-                d["impact_speed_m_s"].get<double>(), d["measured_impact_speed_m_s"].get<double>(),
-                d["rebound_normal_velocity_m_s"].get<double>(),
-                d["restitution_velocity"].get<double>(), d["restitution_energy"].get<double>(),
-                d["rebound_spin_rad_s"].get<double>(), d["lost_J"]["plastic"].get<double>(),
-                d.value("exponent", 0.0));
-  if (r.contains("calibration"))
-    std::printf("calibration  Eq. 35 bounce velocity matched within %.3g %%\n",
-                100 * r["calibration"]["worst_bounce_velocity_error"].get<double>());
-  std::printf("results      %s/results.json  %s/restitution.csv  %s/history.csv\n", out_dir.c_str(),
-              out_dir.c_str(), out_dir.c_str());
-  for (const auto& f : r["files"])
-    if (f.get<std::string>().ends_with(".svg"))
-      std::printf("plot         %s/%s\n", out_dir.c_str(), f.get<std::string>().c_str());
-}
-
 int test_command(const std::string& protocol_file, const std::string& out_dir, bool quiet,
                  std::int64_t checkpoint_every, const std::string& resume) {
-  {
-    const nlohmann::json j = rocklab::read_json_file(protocol_file);
-    if (j.is_object() && j.value("test", std::string()) == "drop") {
-      if (checkpoint_every > 0 || !resume.empty())
-        throw rocklab::InputError(protocol_file +
-                                  ": drop tests are short and have no checkpoints; leave out "
-                                  "--checkpoint-every and --resume");
-      const rocklab::DropProtocol p = rocklab::drop_protocol_from_json(j, protocol_file);
-      const nlohmann::json r = rocklab::run_drop_test(p, out_dir, !quiet, &g_interrupt);
-      if (!quiet)
-        print_drop_results(r, out_dir);
-      return 0;
-    }
-  }
-  const rocklab::Protocol p = rocklab::load_protocol(protocol_file);
+  const nlohmann::json j = rocklab::read_json_file(protocol_file);
+  const std::unique_ptr<rocklab::LabProtocol> test = rocklab::lab_protocol_of(j, protocol_file);
   rocklab::LabOptions o;
   o.out_dir = out_dir;
   o.progress = !quiet && ::isatty(STDERR_FILENO);
   o.interrupt = &g_interrupt;
   o.checkpoint_every = checkpoint_every;
   o.resume_path = resume;
-  const rocklab::LabSummary s = rocklab::run_lab_test(p, o);
+  const rocklab::LabSummary s = test->run(j, protocol_file, o);
   if (s.interrupted) {
     std::fprintf(stderr, "rocklab: interrupted; %s\n",
                  checkpoint_every > 0 ? ("checkpoint written to " + out_dir + ".checkpoint").c_str()
@@ -236,7 +148,7 @@ int test_command(const std::string& protocol_file, const std::string& out_dir, b
     return 130;
   }
   if (!quiet)
-    print_lab_results(s, out_dir);
+    test->print(s, out_dir);
   return 0;
 }
 

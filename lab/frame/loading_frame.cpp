@@ -1,0 +1,332 @@
+// The loading frame's step, records and stop rules, its state for checkpoints and the common part
+// of results.json.
+#include "lab/frame/loading_frame.hpp"
+
+#include "io/json_fields.hpp"
+#include "io/results.hpp"
+#include "lab/protocols/frame_test.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace rocklab {
+
+void ConfinementBand::start(double stress) {
+  min = max = inst_min = inst_max = stress;
+  peak_min = peak_max = stress;
+  seen = false;
+  win_sum = 0;
+  win_n = 0;
+}
+
+void ConfinementBand::add(double stress) {
+  sum += stress;
+  ++n;
+  win_sum += stress;
+  if (++win_n == kWindow) {
+    const double mean = win_sum / kWindow;
+    min = seen ? std::min(min, mean) : mean;
+    max = seen ? std::max(max, mean) : mean;
+    seen = true;
+    win_sum = 0;
+    win_n = 0;
+  }
+  inst_min = std::min(inst_min, stress);
+  inst_max = std::max(inst_max, stress);
+}
+
+nlohmann::json ConfinementBand::json(double) const {
+  return {{"mean", n ? sum / static_cast<double>(n) : 0.0},
+          {"min", min},
+          {"max", max},
+          {"averaging_steps", kWindow},
+          {"before_peak_min", peak_min},
+          {"before_peak_max", peak_max},
+          {"instantaneous_min", inst_min},
+          {"instantaneous_max", inst_max}};
+}
+
+const char* LoadingFrame::phase_name() const {
+  static const char* names[] = {"confining", "seating", "loading", "unloading", "done"};
+  return names[phase_];
+}
+
+void LoadingFrame::begin_loading() {
+  phase_ = kLoad;
+  load_start_step_ = phase_start_step_ = m_.step();
+  sep_ref_ = separation();
+  shell_ref_.clear();
+  for (std::int32_t i : shell_)
+    shell_ref_.push_back(m_.balls.pos[static_cast<std::size_t>(i)]);
+  lateral_ref_.setZero();
+  if (!lateral_.empty()) {
+    if (lateral_axis_[0] < 0)
+      lateral_ref_[0] = m_.walls[static_cast<std::size_t>(lateral_[0])].cylinder_radius;
+    else
+      for (int d = 0; d < geo_.dim; ++d)
+        if (d != geo_.axis)
+          lateral_ref_[d] = lateral_width(d);
+  }
+  LabSample s;
+  measure(s);
+  load_ref_ = s.load;
+  band_.start(s.lateral_stress);
+  next_snapshot_strain_ = p_.vtk_every_strain;
+  snapshot_due_ = p_.vtk; // the start of loading
+}
+
+void LoadingFrame::record_history() {
+  const EnergyLedger en = m_.energy();
+  const LabSample& s = current_;
+  const double vol =
+      s.axial_strain + (geo_.dim == 2 ? 1.0 : 2.0) * s.lateral_strain; // compression positive
+  history_.push_back({s.time, static_cast<double>(s.step), static_cast<double>(phase_),
+                      s.axial_strain, s.lateral_strain, vol, s.axial_stress, s.lateral_stress,
+                      s.load, s.force, static_cast<double>(monitor_.tension()),
+                      static_cast<double>(monitor_.shear()), static_cast<double>(monitor_.total()),
+                      en.kinetic(), en.strain, en.bond_strain, en.slip, en.local_damping,
+                      en.boundary_work});
+}
+
+std::string LoadingFrame::history_csv() const {
+  std::string s = "time_s,step,phase,axial_strain,lateral_strain,volumetric_strain,axial_stress_Pa,"
+                  "lateral_stress_Pa,deviator_Pa,force_N,cracks_tension,cracks_shear,"
+                  "cracks_total,kinetic_J,strain_J,bond_strain_J,slip_J,local_damping_J,"
+                  "boundary_work_J\n";
+  for (const auto& row : history_) {
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      if (k)
+        s += ',';
+      s += (k == 1 || k == 2 || (k >= 10 && k <= 12)) ? std::to_string(std::llround(row[k]))
+                                                      : format_double(row[k]);
+    }
+    s += '\n';
+  }
+  return s;
+}
+
+void LoadingFrame::finish(const std::string& why) {
+  stop_reason_ = why;
+  phase_ = kDone;
+  for (Wall& w : m_.walls) {
+    w.velocity.setZero();
+    w.radial_velocity = 0;
+  }
+  if (history_.empty() || static_cast<std::int64_t>(history_.back()[1]) != m_.step())
+    record_history();
+}
+
+void LoadingFrame::advance() {
+  control();
+  m_.cycle(1);
+  events_.clear();
+  m_.drain_events(events_);
+  for (const Event& ev : events_)
+    bond_break_events_ += ev.type == EventType::BondBreak ? 1 : 0;
+  monitor_.consume(m_, events_);
+  measure(current_);
+  const std::int64_t since = m_.step() - phase_start_step_;
+  if (phase_ == kConfine || phase_ == kSeat) {
+    // The platens (and confining walls) servo to their stress; loading begins once every wall is
+    // within its band and the specimen is at rest.
+    const double target = phase_ == kConfine ? p_.confinement : p_.seating_stress;
+    const double tol = phase_ == kConfine ? p_.confinement_tolerance : 0.1;
+    bool ok = std::abs(current_.axial_stress - target) <= tol * target;
+    for (std::size_t k = 0; k < lateral_.size(); ++k)
+      ok = ok && std::abs(lateral_stress_of(k) - target) <= tol * target;
+    if (since % 100 == 0 && ok && since >= 200 && m_.mean_unbalanced_force_ratio() <= 1e-2) {
+      record_history();
+      begin_loading();
+    } else if (since > p_.max_steps) {
+      throw std::runtime_error(p_.file + ": the " + phase_name() +
+                               " phase did not reach its stress in " +
+                               std::to_string(p_.max_steps) + " steps (key 'stop.max_steps')");
+    }
+    if (since % p_.history_every == 0)
+      record_history();
+    return;
+  }
+  // Loading or unloading.
+  const std::int64_t loading = m_.step() - load_start_step_;
+  const std::int64_t fine = std::max<std::int64_t>(1, p_.history_every / 10);
+  if (loading % fine == 0)
+    samples_.push_back(current_);
+  if (!lateral_.empty())
+    band_.add(current_.lateral_stress);
+  track_peak();
+  if (p_.vtk && p_.vtk_every_strain > 0 && phase_ == kLoad &&
+      current_.axial_strain >= next_snapshot_strain_) {
+    snapshot_due_ = true;
+    while (next_snapshot_strain_ <= current_.axial_strain)
+      next_snapshot_strain_ += p_.vtk_every_strain;
+  }
+  if (loading % p_.history_every == 0)
+    record_history();
+  stop_rules();
+}
+
+void LoadingFrame::track_peak() {
+  if (phase_ != kLoad || current_.load <= peak_.load)
+    return;
+  peak_ = {current_.load,  current_.axial_strain,   current_.axial_stress,
+           current_.force, current_.lateral_strain, current_.time,
+           current_.step,  monitor_.tension(),      monitor_.shear()};
+  band_.peak_min = band_.min;
+  band_.peak_max = band_.max;
+  if (p_.vtk && m_.step() - peak_snap_step_ >= p_.history_every) {
+    peak_snap_due_ = true; // the caller copies a snapshot (throttled)
+    peak_snap_step_ = m_.step();
+  }
+}
+
+bool LoadingFrame::stop_rules() {
+  const std::int64_t loading = m_.step() - load_start_step_;
+  if (phase_ == kLoad && p_.reverse_at_strain > 0 &&
+      current_.axial_strain >= p_.reverse_at_strain) {
+    phase_ = kUnload;
+    reverse_step_ = m_.step();
+    record_history();
+    return false;
+  }
+  if (phase_ == kUnload) {
+    if (current_.axial_strain <= 0 || current_.load <= load_ref_)
+      finish("unloaded to the start");
+    else if (loading > p_.max_steps)
+      finish("stop.max_steps reached");
+    return done();
+  }
+  const bool dropped = loading >= p_.min_steps && peak_.load > load_ref_ &&
+                       current_.load < p_.post_peak_fraction * peak_.load;
+  if (dropped) {
+    // The test decides whether the drop ends it (a Brazilian disk must have split first).
+    const std::string why = test_.stop_after_drop(*this);
+    if (!why.empty())
+      finish(why);
+    else if (loading > p_.max_steps)
+      finish("stop.max_steps reached");
+  } else if (p_.strain_limit > 0 && current_.axial_strain >= p_.strain_limit) {
+    finish("stop.strain_limit reached");
+  } else if (loading > p_.max_steps) {
+    finish("stop.max_steps reached");
+  }
+  return done();
+}
+
+template <class A> void LoadingFrame::fields(A& a) {
+  a.object("geometry", geo_);
+  a("phase", phase_), a("phase_start_step", phase_start_step_);
+  a("load_start_step", load_start_step_), a("reverse_step", reverse_step_);
+  a("top", top_), a("bottom", bottom_), a("lateral", lateral_), a("lateral_axis", lateral_axis_);
+  a("lateral_sign", lateral_sign_), a("grip_top", grip_top_), a("grip_bottom", grip_bottom_);
+  a("shell", shell_), a("v_final", v_final_), a("sep_ref", sep_ref_), a("shell_ref", shell_ref_);
+  a("lateral_ref", lateral_ref_), a("load_ref", load_ref_), a("reference", reference_);
+  a.object("peak", peak_);
+  a.object("confinement_band", band_);
+  a("servo_integral", servo_integral_), a("bond_break_events", bond_break_events_);
+  a("next_snapshot_strain", next_snapshot_strain_), a("snapshot_due", snapshot_due_);
+  a("peak_snap_step", peak_snap_step_), a("stop_reason", stop_reason_), a("history", history_);
+}
+
+nlohmann::json LoadingFrame::state() const {
+  nlohmann::json s = nlohmann::json::object();
+  JsonFieldWriter w{s};
+  const_cast<LoadingFrame*>(this)->fields(w); // the writer only reads
+  nlohmann::json samples = nlohmann::json::array();
+  for (const LabSample& x : samples_)
+    samples.push_back({x.step, x.time, x.axial_strain, x.lateral_strain, x.axial_stress,
+                       x.lateral_stress, x.load, x.force});
+  s["samples"] = std::move(samples);
+  s["cracks"] = monitor_.to_json();
+  nlohmann::json own = nlohmann::json::object();
+  test_.save(own);
+  s["test"] = std::move(own);
+  return s;
+}
+
+void LoadingFrame::restore(const nlohmann::json& s, const std::string& file) {
+  JsonFieldReader r{s, file};
+  fields(r);
+  // Every index the state names must exist in the restored model.
+  auto check = [&](bool ok, const char* what) {
+    if (!ok)
+      throw InputError(file + ": corrupt checkpoint (" + what + " out of range)");
+  };
+  const auto walls = static_cast<std::int64_t>(m_.walls.size());
+  const auto balls = static_cast<std::int32_t>(m_.balls.size());
+  check(phase_ >= kConfine && phase_ <= kDone, "phase");
+  check((top_ == -1 && bottom_ == -1) ||
+            (top_ >= 0 && top_ < walls && bottom_ >= 0 && bottom_ < walls),
+        "platen wall");
+  check(top_ >= 0 || (!grip_top_.empty() && !grip_bottom_.empty()), "grips");
+  for (std::int64_t w : lateral_)
+    check(w >= 0 && w < walls, "confining wall");
+  check(lateral_axis_.size() == lateral_.size() && lateral_sign_.size() == lateral_.size(),
+        "confining wall");
+  for (const auto* list : {&grip_top_, &grip_bottom_, &shell_})
+    for (std::int32_t i : *list)
+      check(i >= 0 && i < balls, "grain index");
+  check(shell_ref_.empty() || shell_ref_.size() == shell_.size(), "lateral-surface grains");
+  const nlohmann::json& samples = r.at("samples");
+  try {
+    samples_.clear();
+    for (const auto& x : samples)
+      samples_.push_back({x.at(0).get<std::int64_t>(), x.at(1).get<double>(), x.at(2).get<double>(),
+                          x.at(3).get<double>(), x.at(4).get<double>(), x.at(5).get<double>(),
+                          x.at(6).get<double>(), x.at(7).get<double>()});
+    monitor_.from_json(r.at("cracks"));
+  } catch (const nlohmann::json::exception&) {
+    throw InputError(file + ": corrupt checkpoint (samples or cracks)");
+  }
+  test_.load(r.at("test"), file);
+  m_.settings.slip_events = false;
+  measure(current_);
+}
+
+nlohmann::json LoadingFrame::results() const {
+  nlohmann::json r;
+  r["units"] = "SI (m, kg, s, N, Pa, J); stresses and strains compression positive";
+  r["test"] = test_.name();
+  r["stop_reason"] = stop_reason_;
+  const double crack_area = [&] {
+    double a = 0;
+    for (const Crack& c : monitor_.cracks())
+      a += geo_.dim == 2 ? c.size : 0.25 * std::numbers::pi * c.size * c.size;
+    return a;
+  }();
+  r["cracks"] = {{"tension", monitor_.tension()},
+                 {"shear", monitor_.shear()},
+                 {"total", monitor_.total()},
+                 {"at_peak",
+                  {{"tension", peak_.tension},
+                   {"shear", peak_.shear},
+                   {"total", peak_.tension + peak_.shear}}},
+                 {"density_per_m3", static_cast<double>(monitor_.total()) / geo_.volume},
+                 {"area_per_volume_per_m", crack_area / geo_.volume}};
+  r["bond_break_events"] = bond_break_events_;
+  r["peak_step"] = peak_.step;
+  r["peak_time_s"] = peak_.time;
+  r["loading_rate"] = {{"platen_velocity_m_per_s", v_final_},
+                       {"strain_rate_per_s", 2 * v_final_ / geo_.loaded_length()}};
+  test_.results(*this, r);
+  nlohmann::json spec = {{"dimension", geo_.dim},
+                         {"grains", m_.balls.size()},
+                         {"height_m", geo_.height0},
+                         {"volume_m3", geo_.volume}};
+  if (geo_.diametral) {
+    spec["diameter_m"] = geo_.width0.x();
+    spec["thickness_m"] = geo_.thickness;
+  } else if (geo_.round) {
+    spec["diameter_m"] = geo_.width0.x();
+  } else {
+    spec["width_m"] = geo_.dim == 2 ? nlohmann::json(geo_.width0.x())
+                                    : nlohmann::json({geo_.width0.x(), geo_.width0.y()});
+  }
+  if (meta_.contains("report"))
+    spec["porosity"] = meta_["report"].value("porosity", 0.0);
+  r["specimen"] = spec;
+  return r;
+}
+
+} // namespace rocklab

@@ -1,0 +1,222 @@
+// The loading frame of the test machine: it measures the specimen, adds the platens (or grips)
+// and confining walls to the model, drives them (seating, confining servo, constant-rate loading,
+// unloading), reads force, strain and stress every step, keeps the records (history, fine samples,
+// peak, confinement band, cracks) and applies the stop rules. A protocol (lab/protocols/) says how
+// the frame is set up for its test and what the readings mean. Talks to the engine only through
+// the Model's public API and its event stream. Units SI; stresses and strains compression
+// positive.
+#pragma once
+
+#include "core/model.hpp"
+#include "lab/crack_monitor.hpp"
+#include "lab/protocol.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rocklab {
+
+class FrameTest;
+
+/// Phases of a test, in order.
+enum Phase : int { kConfine = 0, kSeat = 1, kLoad = 2, kUnload = 3, kDone = 4 };
+
+/// A recorded point of the test (the measurement channels, SI, compression positive).
+struct LabSample {
+  std::int64_t step = 0;
+  double time = 0;
+  double axial_strain = 0;   ///< shortening (compression, Brazilian) or elongation (tension) [-]
+  double lateral_strain = 0; ///< compression positive: bulging is negative [-]
+  double axial_stress = 0;   ///< platen load / current area; Brazilian: 2F/(pi D t) [Pa]
+  double lateral_stress = 0; ///< confining walls [Pa]
+  double load = 0;           ///< the quantity whose peak ends the test [Pa]
+  double force = 0;          ///< platen (grip) force [N], 2D per unit thickness
+};
+
+/// What loads the specimen.
+enum class Actuator { Platens, Grips };
+
+/// How a protocol wants the frame set up.
+struct FrameSetup {
+  bool diametral = false; ///< a disk loaded across its diameter (y axis), else along the axis
+  Actuator actuator = Actuator::Platens; ///< platens, or grips holding the end grains (tension)
+  bool confined = false;                 ///< confining walls hold loading.confinement
+  bool platen_friction = false; ///< platens keep the specimen's wall friction (else lubricated)
+  Phase first_phase = kSeat;    ///< kConfine, kSeat (platens close to the seating stress) or kLoad
+};
+
+/// The specimen as the frame measured it when the test began [m, m^2, m^3].
+struct SpecimenGeometry {
+  int dim = 3;
+  int axis = 2;           ///< loading axis: z (3D) / y (2D); a diametral test loads along y
+  bool round = false;     ///< cylinder (3D) cross-section
+  bool diametral = false; ///< a disk loaded across its diameter
+  Vec3 center = Vec3::Zero();
+  double height0 = 0;         ///< along the loading axis
+  Vec3 width0 = Vec3::Zero(); ///< extents across the axis (cylinder: the diameter)
+  double thickness = 1;       ///< disk thickness (2D: unit thickness)
+  double area0 = 0, volume = 0, r_avg = 0;
+  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero(); ///< the grains' bounding box (2D: z = 0)
+
+  /// The length a strain rate refers to: the diameter across which a disk is loaded, else the
+  /// height.
+  double loaded_length() const { return diametral ? width0.y() : height0; }
+  template <class A> void fields(A& a) {
+    a("dim", dim), a("axis", axis), a("round", round), a("diametral", diametral);
+    a("center", center), a("height0", height0), a("width0", width0), a("thickness", thickness);
+    a("area0", area0), a("volume", volume), a("r_avg", r_avg), a("lo", lo), a("hi", hi);
+  }
+};
+
+/// The peak of the load and the state at it.
+struct PeakRecord {
+  double load = 0, strain = 0, stress = 0, force = 0, lateral = 0, time = 0;
+  std::int64_t step = -1, tension = 0, shear = 0; ///< step and crack counts at the peak
+  template <class A> void fields(A& a) {
+    a("load", load), a("strain", strain), a("stress", stress), a("force", force);
+    a("lateral", lateral), a("time", time), a("step", step), a("tension", tension);
+    a("shear", shear);
+  }
+};
+
+/// The confining stress as a pressure gauge reads it: 100-step means (a few stress-wave transits
+/// of a grain), so single-step spikes from breaking bonds do not count, beside the instantaneous
+/// extremes.
+struct ConfinementBand {
+  static constexpr int kWindow = 100;
+  double min = 0, max = 0, sum = 0;
+  std::int64_t n = 0, win_n = 0;
+  double win_sum = 0, inst_min = 0, inst_max = 0;
+  bool seen = false;
+  double peak_min = 0, peak_max = 0; ///< the band up to the peak
+
+  void start(double stress);
+  void add(double stress);
+  nlohmann::json json(double confinement) const;
+  template <class A> void fields(A& a) {
+    a("min", min), a("max", max), a("sum", sum), a("n", n), a("win_n", win_n);
+    a("win_sum", win_sum), a("inst_min", inst_min), a("inst_max", inst_max), a("seen", seen);
+    a("peak_min", peak_min), a("peak_max", peak_max);
+  }
+};
+
+class LoadingFrame {
+public:
+  LoadingFrame(const Protocol& p, FrameTest& test, Model& m, const nlohmann::json& meta)
+      : p_(p), test_(test), m_(m), meta_(meta) {}
+
+  /// Measure the specimen, add the machine's walls and grips, start the first phase.
+  void setup();
+  /// One step: control, cycle, events, measurement, records, stop rules.
+  void advance();
+  bool done() const { return phase_ == kDone; }
+  /// Everything a continued run depends on, and its restoration (the model is restored apart).
+  nlohmann::json state() const;
+  void restore(const nlohmann::json& state, const std::string& file);
+  /// results.json: the frame's part and the protocol's.
+  nlohmann::json results() const;
+  std::string history_csv() const;
+
+  // What protocols read.
+  const Protocol& protocol() const { return p_; }
+  const Model& model() const { return m_; }
+  const SpecimenGeometry& geometry() const { return geo_; }
+  const CrackMonitor& cracks() const { return monitor_; }
+  const std::vector<LabSample>& samples() const { return samples_; }
+  const LabSample& current() const { return current_; }
+  const PeakRecord& peak() const { return peak_; }
+  const nlohmann::json& specimen_meta() const { return meta_; }
+  double load_ref() const { return load_ref_; }       ///< load when loading began [Pa]
+  double sep_ref() const { return sep_ref_; }         ///< separation when loading began [m]
+  double separation() const;                          ///< platen or grip separation [m]
+  double platen_velocity() const { return v_final_; } ///< while loading [m/s]
+  std::int64_t load_start_step() const { return load_start_step_; }
+  std::int64_t reverse_step() const { return reverse_step_; }
+  bool confined() const { return !lateral_.empty(); }
+  const ConfinementBand& confinement_band() const { return band_; }
+  bool loading() const { return phase_ >= kLoad; }
+  /// The current cross-section [m^2] (confined: the walls'; else widened by the lateral strain).
+  double current_area(double lateral_strain) const;
+
+  // What the run loop reads.
+  bool snapshot_due() const { return snapshot_due_; }
+  void snapshot_taken() { snapshot_due_ = false; }
+  bool peak_snapshot_due() const { return peak_snap_due_; }
+  void peak_snapshot_taken() { peak_snap_due_ = false; }
+  int phase() const { return phase_; }
+  const char* phase_name() const;
+  const std::vector<Vec3>& reference_positions() const { return reference_; }
+
+private:
+  // setup.cpp
+  void measure_specimen(const std::string& shape, bool diametral);
+  LinearProps platen_contact(bool friction) const;
+  std::int64_t add_wall(Wall w, const LinearProps& props);
+  void add_platens(const LinearProps& props);
+  void add_grips();
+  void add_confinement(const LinearProps& props);
+  void find_shell();
+  // measure.cpp
+  void measure(LabSample& s) const;
+  double lateral_width(int d) const;
+  double face_area(std::size_t k) const;
+  double lateral_stress_of(std::size_t k) const;
+  double lateral_strain() const;
+  double shell_strain() const;
+  // control.cpp
+  void control();
+  void gather_wall_sums();
+  double servo_velocity(std::size_t wall, double target, double area, double stress) const;
+  double follow_velocity(std::size_t k) const;
+  void drive(double v);
+  // loading_frame.cpp
+  void record_history();
+  void begin_loading();
+  void finish(const std::string& why);
+  void track_peak();
+  bool stop_rules();
+  template <class A> void fields(A& a);
+
+  const Protocol& p_;
+  FrameTest& test_;
+  Model& m_;
+  const nlohmann::json& meta_;
+  SpecimenGeometry geo_;
+  // machine parts
+  std::int64_t top_ = -1, bottom_ = -1; ///< platen walls; -1 in direct tension (grips)
+  std::vector<std::int64_t> lateral_;   ///< confining walls
+  std::vector<int> lateral_axis_;       ///< axis of each (-1: the cylinder)
+  std::vector<double> lateral_sign_;    ///< +1 for the wall on the + side
+  std::vector<std::int32_t> grip_top_, grip_bottom_, shell_;
+  // state
+  int phase_ = kSeat;
+  std::int64_t phase_start_step_ = 0, load_start_step_ = 0, reverse_step_ = -1;
+  double v_final_ = 0; ///< platen (grip) speed while loading [m/s]
+  double sep_ref_ = 0; ///< platen or grip separation when loading began [m]
+  std::vector<Vec3> shell_ref_;
+  Vec3 lateral_ref_ = Vec3::Zero(); ///< wall widths (cylinder radius in [0]) when loading began
+  double load_ref_ = 0;             ///< load when loading began (the seating stress)
+  std::vector<Vec3> reference_;     ///< grain positions when the test began
+  PeakRecord peak_;
+  ConfinementBand band_;
+  std::vector<double> servo_integral_; ///< sum of the confinement error of each wall [Pa]
+  // per-step servo sums by wall index (derived each step, reused buffers)
+  std::vector<double> wall_k_, wall_f_, wall_fv_;
+  std::vector<int> lateral_of_wall_;
+  std::int64_t bond_break_events_ = 0; ///< bond_break events seen (each becomes a crack)
+  double next_snapshot_strain_ = 0;
+  bool snapshot_due_ = false, peak_snap_due_ = false;
+  std::int64_t peak_snap_step_ = -1;
+  std::string stop_reason_;
+  LabSample current_;
+  std::vector<LabSample> samples_; ///< fine record of the loading (fits)
+  std::vector<std::vector<double>> history_;
+  CrackMonitor monitor_;
+  std::vector<Event> events_;
+};
+
+} // namespace rocklab

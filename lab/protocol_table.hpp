@@ -1,0 +1,28 @@
+// The table of laboratory tests by the name a protocol file gives in "test". Adding a test: its
+// file under lab/protocols/, one row in protocol_table.cpp, its docs and its test.
+#pragma once
+
+#include "lab/lab_protocol.hpp"
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace rocklab {
+
+class FrameTest;
+
+/// The names of every test, in table order.
+std::vector<std::string> lab_protocol_names();
+/// The names of the tests run in the loading frame (protocol files with a specimen; suites).
+std::vector<std::string> frame_test_names();
+/// A fresh instance of the test named `name` (nullptr if there is none).
+std::unique_ptr<LabProtocol> make_lab_protocol(std::string_view name);
+/// A fresh instance of the frame test named `name` (nullptr if it is not one).
+std::unique_ptr<FrameTest> make_frame_test(std::string_view name);
+/// The test a protocol file asks for (its "test" key); a missing or unknown name fails like any
+/// bad key (InputError naming the file).
+std::unique_ptr<LabProtocol> lab_protocol_of(const nlohmann::json& j, const std::string& file);
+
+} // namespace rocklab

@@ -1,0 +1,19 @@
+// What the compression tests (UCS and triaxial) share: the axial strain of the platens, the axial
+// stress over the current section and the deviator as the load, the elastic constants, the
+// confinement band and the loading/unloading moduli in results.json, and the plot with the
+// lateral strain. Units SI.
+#pragma once
+
+#include "lab/protocols/frame_test.hpp"
+
+namespace rocklab {
+
+class CompressionTest : public FrameTest {
+public:
+  double axial_strain(const LoadingFrame& f) const override;
+  void stresses(const LoadingFrame& f, LabSample& s) const override;
+  void results(const LoadingFrame& f, nlohmann::json& r) const override;
+  PlotLabels plot_labels() const override;
+};
+
+} // namespace rocklab

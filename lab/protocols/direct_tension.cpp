@@ -1,0 +1,45 @@
+// Direct tension: grips hold the grains near both ends of the specimen and pull them apart at a
+// constant rate; the tensile strength is the peak force over the initial section
+// (docs/protocol-format.md).
+#include "lab/protocols/frame_test.hpp"
+
+#include "lab/frame/elastic_fit.hpp"
+
+namespace rocklab {
+
+namespace {
+
+class DirectTensionTest final : public FrameTest {
+public:
+  const char* name() const override { return "direct_tension"; }
+  FrameSetup setup() const override {
+    FrameSetup s;
+    s.actuator = Actuator::Grips;
+    s.first_phase = kLoad;
+    return s;
+  }
+  double axial_strain(const LoadingFrame& f) const override {
+    return (f.separation() - f.sep_ref()) / f.geometry().height0; // elongation
+  }
+  void stresses(const LoadingFrame& f, LabSample& s) const override {
+    s.axial_stress = s.force / f.geometry().area0;
+    s.load = s.axial_stress;
+  }
+  void results(const LoadingFrame& f, nlohmann::json& r) const override {
+    r["tensile_strength_Pa"] = f.peak().load;
+    r["peak_force_N"] = f.peak().force;
+    r["peak_axial_strain"] = f.peak().strain;
+    r["youngs_modulus_Pa"] = fit_elastic(f.samples(), f.peak().load, 0.4, 0.6).youngs_modulus;
+  }
+  PlotLabels plot_labels() const override {
+    return {"strain [%] (compression positive)", "tensile stress [MPa]", false, 1};
+  }
+};
+
+} // namespace
+
+std::unique_ptr<LabProtocol> make_direct_tension_test() {
+  return std::make_unique<DirectTensionTest>();
+}
+
+} // namespace rocklab

@@ -1,0 +1,35 @@
+// The defaults of a test in the loading frame: unconfined, no Brazilian stop keys, not a disk, and
+// the standard post-peak stop rule.
+#include "lab/protocols/frame_test.hpp"
+
+#include "io/json_input.hpp"
+#include "io/results.hpp"
+
+namespace rocklab {
+
+void FrameTest::check_loading(JsonObject& loading, const Protocol& p) const {
+  if (p.confinement > 0)
+    loading.fail("confinement", "only a triaxial test is confined (use \"test\": \"triaxial\")");
+}
+
+void FrameTest::check_stop(JsonObject& stop) const {
+  if (stop.has("split_fraction") || stop.has("failed_fraction"))
+    stop.fail(stop.has("split_fraction") ? "split_fraction" : "failed_fraction",
+              "applies to Brazilian tests only");
+}
+
+void FrameTest::check_shape(const std::string& shape, const Protocol& p) const {
+  if (shape == "disk")
+    throw InputError(p.file + ": key 'specimen': a disk specimen is for Brazilian tests; give a "
+                              "cylinder, prism or rectangle");
+}
+
+std::string FrameTest::stop_after_drop(const LoadingFrame& f) {
+  return load_fell_reason(f.protocol());
+}
+
+std::string load_fell_reason(const Protocol& p) {
+  return "the load fell below " + format_double(p.post_peak_fraction) + " of its peak";
+}
+
+} // namespace rocklab

@@ -1,0 +1,54 @@
+// A laboratory test in the loading frame (UCS, triaxial, Brazilian, direct tension, ...): how the
+// frame is set up, what its readings mean, when the test ends, what it reports and how it is
+// plotted. One file per test under lab/protocols/, one row in lab/protocol_table.cpp; the frame
+// (lab/frame/) and the run loop (lab/run_test.cpp) do the rest. Units SI.
+#pragma once
+
+#include "lab/frame/loading_frame.hpp"
+#include "lab/lab_protocol.hpp"
+
+#include <string>
+
+namespace rocklab {
+
+class JsonObject;
+
+/// How a test's stress-strain plot and crack map are drawn.
+struct PlotLabels {
+  std::string x, y;     ///< axis labels
+  bool lateral = false; ///< also plot the axial stress against the lateral strain
+  int map_axis = 1;     ///< the crack map's section normal (0 x, 1 y, 2 z)
+};
+
+class FrameTest : public LabProtocol {
+public:
+  /// Runs the protocol file in the frame (lab/run_test.cpp).
+  LabSummary run(const nlohmann::json& j, const std::string& file, const LabOptions& o) override;
+  void print(const LabSummary& s, const std::string& out_dir) const override;
+
+  virtual FrameSetup setup() const = 0;
+  /// Protocol keys whose rules depend on the test, checked where the protocol file reads them:
+  /// by default a test is not confined and has no Brazilian stop keys.
+  virtual void check_loading(JsonObject& loading, const Protocol& p) const;
+  virtual void check_stop(JsonObject& stop) const;
+  /// The specimen's shape from its genesis record ("" without one): by default not a disk.
+  virtual void check_shape(const std::string& shape, const Protocol& p) const;
+  /// The axial strain of the current reading (called while loading) [-].
+  virtual double axial_strain(const LoadingFrame& f) const = 0;
+  /// Axial stress and load of a reading whose force and lateral channels are read [Pa].
+  virtual void stresses(const LoadingFrame& f, LabSample& s) const = 0;
+  /// Called at stop checks once the load fell below stop.post_peak_fraction of its peak: the stop
+  /// reason, or "" to go on (default: stop).
+  virtual std::string stop_after_drop(const LoadingFrame& f);
+  /// The test's own results (the frame writes the common ones).
+  virtual void results(const LoadingFrame& f, nlohmann::json& r) const = 0;
+  virtual PlotLabels plot_labels() const = 0;
+  /// The test's own state, for checkpoints.
+  virtual void save(nlohmann::json& /*state*/) const {}
+  virtual void load(const nlohmann::json& /*state*/, const std::string& /*file*/) {}
+};
+
+/// The stop reason of the standard post-peak rule.
+std::string load_fell_reason(const Protocol& p);
+
+} // namespace rocklab

@@ -1,0 +1,33 @@
+// Triaxial compression: confining walls (a cylinder, or plates on the faces of a prism; 2D: a
+// biaxial test) servo-controlled to loading.confinement, then the platens load the specimen; the
+// peak deviator and the confinement band held (docs/protocol-format.md).
+#include "lab/protocols/compression.hpp"
+
+#include "io/json_input.hpp"
+
+namespace rocklab {
+
+namespace {
+
+class TriaxialTest final : public CompressionTest {
+public:
+  const char* name() const override { return "triaxial"; }
+  FrameSetup setup() const override {
+    FrameSetup s;
+    s.confined = true;
+    s.first_phase = kConfine;
+    return s;
+  }
+  void check_loading(JsonObject& loading, const Protocol& p) const override {
+    if (!(p.confinement > 0))
+      loading.fail("confinement", "a triaxial test needs a confining stress > 0 Pa");
+  }
+};
+
+} // namespace
+
+std::unique_ptr<LabProtocol> make_triaxial_test() {
+  return std::make_unique<TriaxialTest>();
+}
+
+} // namespace rocklab

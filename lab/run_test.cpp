@@ -1,0 +1,341 @@
+#include "lab/run_test.hpp"
+
+#include "io/json_input.hpp"
+#include "io/output_dir.hpp"
+#include "io/results.hpp"
+#include "io/specimen.hpp"
+#include "lab/protocol_table.hpp"
+#include "lab/protocols/frame_test.hpp"
+#include "materials/genesis.hpp"
+#include "viz/svg_plots.hpp"
+#include "viz/vtk_output.hpp"
+
+#include <omp.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+
+namespace rocklab {
+
+namespace fs = std::filesystem;
+
+SpecimenSource obtain_specimen(const Protocol& p, const std::atomic<bool>* interrupt,
+                               bool progress) {
+  SpecimenSource src;
+  if (!p.specimen_file.empty()) {
+    src.model = load_model(p.specimen_file, &src.meta);
+    return src;
+  }
+  MaterialCard card = load_material_card(p.material_file);
+  apply_overrides(card,
+                  {{p.shape, p.file, "specimen.shape"}, {p.cut, p.file, "specimen.cut"}, p.seed});
+  GenesisResult g = run_genesis(
+      card,
+      [&](const std::string& s) {
+        if (progress)
+          std::fprintf(stderr, "[rocklab genesis] %s\n", s.c_str());
+      },
+      interrupt);
+  src.meta = specimen_meta(card, g.report);
+  src.model = std::move(g.model);
+  return src;
+}
+
+namespace {
+
+/// What the frame shows at one moment, with every crack so far.
+Snapshot frame_snapshot(const LoadingFrame& f) {
+  Snapshot s = take_snapshot(f.model(), f.reference_positions(), f.current().axial_strain);
+  for (const Crack& c : f.cracks().cracks())
+    s.cracks.push_back({c.position, c.normal, c.size, c.mode, c.time, c.step});
+  return s;
+}
+
+/// A test in progress: the model, the frame around it, the ParaView series and the checkpoint.
+struct FrameRun {
+  FrameRun(const Protocol& protocol, const LabOptions& options, OutputDir& dir, LabSummary& summary,
+           std::string checkpoint_path)
+      : p(protocol), o(options), out(dir), sum(summary), checkpoint(std::move(checkpoint_path)) {}
+
+  const Protocol& p;
+  const LabOptions& o;
+  OutputDir& out;
+  LabSummary& sum;
+  std::string checkpoint;
+  std::unique_ptr<Model> model;
+  nlohmann::json meta;
+  std::unique_ptr<LoadingFrame> frame;
+  std::unique_ptr<VtkSeries> vtk;
+  Snapshot peak_snap;
+  bool have_peak_snap = false;
+
+  void start(FrameTest& test);
+  void resume(FrameTest& test);
+  void write_checkpoint();
+  bool loop(); ///< false: interrupted
+  void write_outputs(const FrameTest& test, std::chrono::steady_clock::time_point t0);
+};
+
+void FrameRun::start(FrameTest& test) {
+  vtk = std::make_unique<VtkSeries>(out.staged("vtk"));
+  if (!o.resume_path.empty()) {
+    resume(test);
+    return;
+  }
+  SpecimenSource src = obtain_specimen(p, o.interrupt, o.progress);
+  model = std::move(src.model);
+  meta = std::move(src.meta);
+  if (!p.material_file.empty()) {
+    save_model(*model, out.staged("specimen.rlspec").string(), meta);
+    sum.files.push_back("specimen.rlspec");
+  }
+  frame = std::make_unique<LoadingFrame>(p, test, *model, meta);
+  frame->setup();
+}
+
+void FrameRun::resume(FrameTest& test) {
+  nlohmann::json cmeta;
+  model = load_model(o.resume_path, &cmeta);
+  if (!cmeta.contains("lab") || !cmeta["lab"].contains("machine"))
+    throw InputError(o.resume_path + ": not a rocklab test checkpoint");
+  const nlohmann::json& lab = cmeta["lab"];
+  if (lab.value("protocol_hash", "") != p.text_hash)
+    throw InputError(o.resume_path +
+                     ": the checkpoint belongs to another protocol (key "
+                     "'protocol_hash' differs from " +
+                     p.file + ")");
+  try {
+    meta = lab.at("specimen_meta");
+    vtk->set_times(lab.at("vtk_times").get<std::vector<double>>());
+    vtk->set_tagged(lab.at("vtk_tagged").get<std::map<std::string, double>>());
+    sum.files = lab.at("files").get<std::vector<std::string>>();
+  } catch (const nlohmann::json::exception&) {
+    throw InputError(o.resume_path + ": corrupt checkpoint (its 'lab' record)");
+  }
+  // Files written before the checkpoint (specimen, snapshots) were saved beside it.
+  const fs::path saved = o.resume_path + ".files";
+  if (fs::exists(saved))
+    fs::copy(saved, out.staged(""),
+             fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  frame = std::make_unique<LoadingFrame>(p, test, *model, meta);
+  frame->restore(lab["machine"], o.resume_path);
+}
+
+void FrameRun::write_checkpoint() {
+  // A peak snapshot still in memory goes into the series now, so a resumed run has it too.
+  if (have_peak_snap) {
+    vtk->write(peak_snap, "peak");
+    have_peak_snap = false;
+  }
+  nlohmann::json cmeta = {{"lab",
+                           {{"protocol_file", p.file},
+                            {"protocol_hash", p.text_hash},
+                            {"specimen_meta", meta},
+                            {"machine", frame->state()},
+                            {"vtk_times", vtk->times()},
+                            {"vtk_tagged", vtk->tagged()},
+                            {"files", sum.files}}}};
+  // The files written so far are kept beside the checkpoint (a copy of the staging folder).
+  const fs::path files = checkpoint + ".files";
+  const fs::path tmp = checkpoint + ".files.partial";
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+  fs::create_directories(tmp);
+  fs::copy(out.staged(""), tmp, fs::copy_options::recursive);
+  save_model(*model, checkpoint + ".pending", cmeta);
+  fs::remove_all(files, ec);
+  fs::rename(tmp, files);
+  fs::rename(checkpoint + ".pending", checkpoint);
+}
+
+bool FrameRun::loop() {
+  using clock = std::chrono::steady_clock;
+  auto last_print = clock::now();
+  LoadingFrame& f = *frame;
+  while (!f.done()) {
+    f.advance();
+    if (f.snapshot_due()) {
+      if (p.vtk)
+        vtk->write(frame_snapshot(f));
+      f.snapshot_taken();
+    }
+    if (f.peak_snapshot_due()) {
+      peak_snap = frame_snapshot(f);
+      have_peak_snap = true;
+      f.peak_snapshot_taken();
+    }
+    if (o.checkpoint_every > 0 && model->step() % o.checkpoint_every == 0)
+      write_checkpoint();
+    if (o.interrupt && o.interrupt->load()) {
+      if (o.checkpoint_every > 0)
+        write_checkpoint();
+      return false; // OUTDIR is left untouched (the staging folder goes away)
+    }
+    if (o.progress && clock::now() - last_print > std::chrono::seconds(2)) {
+      last_print = clock::now();
+      const LabSample& c = f.current();
+      std::fprintf(stderr,
+                   "[rocklab test] %s: step %lld  axial strain %.4g  stress %.4g Pa  peak %.4g Pa"
+                   "  cracks %lld\n",
+                   f.phase_name(), static_cast<long long>(model->step()), c.axial_strain,
+                   c.axial_stress, f.peak().load, static_cast<long long>(f.cracks().total()));
+    }
+  }
+  return true;
+}
+
+// Stress-strain plot with crack counts; crack map of the final state.
+void write_plots(const FrameTest& test, const LoadingFrame& f, const nlohmann::json& meta,
+                 OutputDir& out, std::vector<std::string>& files) {
+  const PlotLabels labels = test.plot_labels();
+  PlotSeries axial{"axial stress vs axial strain", {}, {}, "#000000"};
+  PlotSeries lateral{"axial stress vs lateral strain", {}, {}, "#7f7f7f", true};
+  PlotSeries ct{"tensile cracks", {}, {}, "#d62728", false, true};
+  PlotSeries cs{"shear cracks", {}, {}, "#1f3fbf", false, true};
+  std::size_t crack_i = 0;
+  std::int64_t nt = 0, ns = 0;
+  const auto& cracks = f.cracks().cracks();
+  for (const LabSample& s : f.samples()) {
+    while (crack_i < cracks.size() && cracks[crack_i].step <= s.step)
+      (cracks[crack_i++].mode == 1 ? nt : ns) += 1;
+    axial.x.push_back(100 * s.axial_strain);
+    axial.y.push_back(1e-6 * s.axial_stress);
+    ct.x.push_back(100 * s.axial_strain);
+    ct.y.push_back(static_cast<double>(nt));
+    cs.x.push_back(100 * s.axial_strain);
+    cs.y.push_back(static_cast<double>(ns));
+    if (labels.lateral) {
+      lateral.x.push_back(100 * s.lateral_strain);
+      lateral.y.push_back(1e-6 * s.axial_stress);
+    }
+  }
+  std::vector<PlotSeries> series{axial};
+  if (!lateral.x.empty())
+    series.push_back(lateral);
+  series.push_back(ct);
+  series.push_back(cs);
+  const std::string title =
+      std::string(test.name()) + " test: " + meta.value("material_name", std::string("specimen"));
+  write_text_file(out.staged("stress_strain.svg"),
+                  line_plot_svg(title, labels.x, labels.y, "cracks", series));
+  write_text_file(out.staged("crack_map.svg"),
+                  crack_map_svg(frame_snapshot(f), title + ", cracks at the end", labels.map_axis));
+  files.insert(files.end(), {"stress_strain.svg", "crack_map.svg"});
+}
+
+void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::time_point t0) {
+  const LoadingFrame& f = *frame;
+  // The final snapshot, and the latest peak snapshot (as the "peak" files, placed in the .pvd by
+  // its time; a checkpoint may have written an earlier one already).
+  if (p.vtk) {
+    if (have_peak_snap)
+      vtk->write(peak_snap, "peak");
+    vtk->write(frame_snapshot(f));
+    for (const std::string& name : vtk->write_collections())
+      sum.files.push_back("vtk/" + name);
+  }
+  sum.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  nlohmann::json r = f.results();
+  r["protocol"] = p.file;
+  r["provenance"] = {{"rocklab_version", ROCKLAB_VERSION},
+                     {"material", meta.value("material_name", "")},
+                     {"material_file", meta.value("material_file", "")},
+                     {"material_hash", meta.value("material_hash", "")},
+                     {"seed", meta.value("seed", std::uint64_t{0})},
+                     {"specimen_file", p.specimen_file},
+                     {"protocol_hash", p.text_hash},
+                     {"grains", model->balls.size()},
+                     {"steps", model->step()},
+                     {"model_time_s", model->time()},
+                     {"threads", omp_get_max_threads()},
+                     {"wall_time_s", sum.wall_seconds}};
+  write_text_file(out.staged("history.csv"), f.history_csv());
+  write_text_file(out.staged("cracks.csv"), f.cracks().csv());
+  sum.files.insert(sum.files.end(), {"results.json", "history.csv", "cracks.csv"});
+  if (p.plots)
+    write_plots(test, f, meta, out, sum.files);
+  r["files"] = sum.files;
+  sum.results = r;
+  write_text_file(out.staged("results.json"), r.dump(2) + "\n");
+}
+
+} // namespace
+
+LabSummary run_frame_test(FrameTest& test, const Protocol& p, const LabOptions& o) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  LabSummary sum;
+  OutputDir out(o.out_dir);
+  FrameRun run{p, o, out, sum,
+               o.checkpoint_path.empty() ? o.out_dir + ".checkpoint" : o.checkpoint_path};
+  run.start(test);
+  if (!run.loop()) {
+    sum.interrupted = true;
+    return sum;
+  }
+  run.write_outputs(test, t0);
+  out.commit();
+  // A finished run needs no checkpoint.
+  std::error_code ec;
+  if (o.checkpoint_every > 0 || !o.resume_path.empty()) {
+    fs::remove(run.checkpoint, ec);
+    fs::remove_all(run.checkpoint + ".files", ec);
+  }
+  return sum;
+}
+
+LabSummary run_lab_test(const Protocol& p, const LabOptions& o) {
+  const std::unique_ptr<FrameTest> test = make_frame_test(p.test);
+  return run_frame_test(*test, p, o);
+}
+
+LabSummary FrameTest::run(const nlohmann::json&, const std::string& file, const LabOptions& o) {
+  return run_frame_test(*this, load_protocol(file), o);
+}
+
+void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
+  const nlohmann::json& r = s.results;
+  auto mpa = [&](const char* key) { return r.contains(key) ? r[key].get<double>() * 1e-6 : 0.0; };
+  std::printf("test         %s   material %s   grains %lld   steps %lld\n",
+              r["test"].get<std::string>().c_str(),
+              r["provenance"]["material"].get<std::string>().c_str(),
+              static_cast<long long>(r["provenance"]["grains"].get<std::int64_t>()),
+              static_cast<long long>(r["provenance"]["steps"].get<std::int64_t>()));
+  if (r.contains("peak_stress_Pa")) {
+    std::printf("peak stress  %.4g MPa (deviator %.4g MPa) at axial strain %.4g %%\n",
+                mpa("peak_stress_Pa"), mpa("peak_deviator_Pa"),
+                100 * r["peak_axial_strain"].get<double>());
+    std::printf("E            %.4g GPa tangent at 50 %% of peak, %.4g GPa secant   poisson %.3f\n",
+                1e-3 * mpa("youngs_modulus_Pa"), 1e-3 * mpa("youngs_modulus_secant_Pa"),
+                r["poisson_ratio"].get<double>());
+    if (r.value("confinement_Pa", 0.0) > 0)
+      std::printf("confinement  %.4g MPa (held between %.4g and %.4g MPa)\n", mpa("confinement_Pa"),
+                  1e-6 * r["confinement_measured_Pa"]["min"].get<double>(),
+                  1e-6 * r["confinement_measured_Pa"]["max"].get<double>());
+  }
+  if (r.contains("tensile_strength_Pa"))
+    std::printf("tensile strength %.4g MPa (peak force %.4g N)\n", mpa("tensile_strength_Pa"),
+                r["peak_force_N"].get<double>());
+  const auto& c = r["cracks"];
+  std::printf("cracks       %lld tension, %lld shear (%lld at peak)\n",
+              static_cast<long long>(c["tension"].get<std::int64_t>()),
+              static_cast<long long>(c["shear"].get<std::int64_t>()),
+              static_cast<long long>(c["at_peak"]["total"].get<std::int64_t>()));
+  std::printf("stopped      %s\n", r["stop_reason"].get<std::string>().c_str());
+  std::printf("wall time    %.1f s on %d thread(s)\n", s.wall_seconds, omp_get_max_threads());
+  std::printf("results      %s/results.json  %s/history.csv  %s/cracks.csv\n", out_dir.c_str(),
+              out_dir.c_str(), out_dir.c_str());
+  for (const auto& f : r["files"]) {
+    const std::string name = f.get<std::string>();
+    if (name.ends_with(".svg"))
+      std::printf("plot         %s/%s\n", out_dir.c_str(), name.c_str());
+    else if (name == "vtk/grains.pvd")
+      std::printf("ParaView     %s/vtk/grains.pvd (also bonds.pvd, cracks.pvd, walls.pvd; "
+                  "viz/rocklab_paraview.py sets up the view)\n",
+                  out_dir.c_str());
+  }
+}
+
+} // namespace rocklab

@@ -1,0 +1,123 @@
+// Material genesis stage by stage (docs/material-format.md, ../shared/DESIGN.md): the work in
+// progress every stage reads and changes, and the stages run_genesis calls in order, one file
+// each under materials/genesis/. Internal to materials/. Units SI.
+#pragma once
+
+#include "core/model.hpp"
+#include "materials/genesis.hpp"
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace rocklab::genesis {
+
+/// A uniform draw in [0, 1) from the run's own generator (portable across standard libraries).
+double uniform01(std::mt19937_64& rng);
+/// A draw from Normal(mean, sd), clamped at zero (Box-Muller on uniform01).
+double normal(std::mt19937_64& rng, const Distribution& d);
+double grain_volume(int dim, double r);
+double grain_volume_sum(const Model& m);
+
+/// A servo-controlled vessel wall.
+struct Servo {
+  std::size_t wall = 0;
+  Vec3 n_in = Vec3::Zero(); ///< planar walls: inward normal
+  bool radial = false;      ///< the round wall (cylinder or circle)
+};
+
+/// The vessel of the card's specimen shape: planar walls and, for round shapes, a cylinder
+/// (circle in 2D) wall, each servo-controlled (vessel.cpp).
+struct Vessel {
+  int dim = 3;
+  SpecimenShape shape = SpecimenShape::Prism;
+  std::vector<Servo> servos;
+
+  double radius(const Model& m, const Servo& s) const { return m.walls[s.wall].cylinder_radius; }
+  /// Current extent along `axis` between the two planar walls normal to it [m].
+  double extent(const Model& m, int axis) const;
+  double lateral_radius(const Model& m) const;
+  double volume(const Model& m) const;
+  /// The area a wall loads [m^2] (2D: per unit thickness).
+  double area(const Model& m, const Servo& s) const;
+  /// Distance of a wall from the vessel centre (its radius for the round wall) [m].
+  double half_extent(const Model& m, const Servo& s) const;
+  /// Compressive stress on a wall [Pa].
+  double stress(const Model& m, const Servo& s) const;
+  /// The vessel as a specimen shape (its size now).
+  ShapeSpec shape_now(const Model& m) const;
+};
+
+/// Add the vessel of the card's specimen shape to the model, every length times `scale`.
+Vessel make_vessel(Model& m, const MaterialCard& card, double scale);
+
+/// One genesis run: the card, the model being made, its report and what the stages hand on.
+struct Run {
+  Run(const MaterialCard& c, Model& model, GenesisReport& r,
+      const std::function<void(const std::string&)>& p, const std::atomic<bool>* i)
+      : card(c), m(model), rep(r), progress(p), interrupt(i), rng(c.seed) {}
+
+  const MaterialCard& card;
+  Model& m;
+  GenesisReport& rep;
+  const std::function<void(const std::string&)>& progress;
+  const std::atomic<bool>* interrupt;
+  std::mt19937_64 rng;         ///< the card's seed; every random draw of genesis, in stage order
+  std::vector<double> radii;   ///< grain radii at their final size, in ball order [m]
+  double r_avg = 0;            ///< mean grain radius [m]
+  bool contraction = true;     ///< packing by boundary contraction (else by grain scaling)
+  double vessel_scale = 1;     ///< vessel size of the cloud / the card's
+  double grain_scale = 1;      ///< grain size in the cloud / final
+  Vessel vessel;               ///< the servo-controlled walls
+  LinearProps stiff;           ///< the card's grain stiffness, installed once the porosity locks
+  double speed_cap = 0.01;     ///< largest wall displacement per step / mean radius
+  double largest_half = 0;     ///< largest wall distance from the centre when compaction began [m]
+  double installed_volume = 0; ///< vessel volume at the end of installation [m^3]
+  std::vector<double> k_sums;  ///< the servo's per-wall stiffness sums (reused)
+
+  void say(const std::string& s) const {
+    if (progress)
+      progress(s);
+  }
+  void check_interrupt() const {
+    if (interrupt && interrupt->load())
+      throw std::runtime_error("interrupted");
+  }
+  /// Cycle in chunks of `check` until done(); a phase that does not finish within the card's
+  /// max_cycles fails naming the key. Returns the cycles run.
+  template <class Done> std::int64_t run_until(const char* phase, std::int64_t check, Done&& done) {
+    const std::int64_t start = m.step();
+    while (!done()) {
+      if (m.step() - start > card.max_cycles)
+        throw std::runtime_error(card.file + ": genesis phase '" + phase +
+                                 "' did not converge in " + std::to_string(card.max_cycles) +
+                                 " cycles (key 'packing.max_cycles')");
+      m.cycle(check);
+      m.clear_events();
+      check_interrupt();
+    }
+    return m.step() - start;
+  }
+  /// One servo step of every vessel wall toward `target` [Pa]: the wall speed closes half the
+  /// stress error per step, capped so the vessel contracts at one strain rate (the cap is
+  /// proportional to the wall's distance from the centre).
+  void servo_step(double target);
+  bool stresses_within(double target, double tol) const;
+  double porosity_now() const;
+};
+
+// The stages, in order (the file that holds each).
+void place_grains(Run& g);      ///< cloud.cpp: radii, a cloud in the enlarged vessel, Morton order
+void relax_cloud(Run& g);       ///< packing.cpp: soft packing springs, the cloud relaxed
+void compact(Run& g);           ///< compaction.cpp: to the porosity at the pressure, installed
+void remove_floaters(Run& g);   ///< floaters.cpp: count floaters, coordination; remove if asked
+void join_clumps(Run& g);       ///< clumps.cpp: touching grains into rigid clumps (thesis App. B)
+void finalize_contacts(Run& g); ///< finalization.cpp: bonds where the gap is within g_i
+void release(Run& g);           ///< release.cpp: unload and remove the vessel, cut, relax
+void insert_joints(Run& g);     ///< joints.cpp: contacts across joint planes become smooth joints
+
+} // namespace rocklab::genesis
