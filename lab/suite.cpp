@@ -4,28 +4,20 @@
 #include "io/output_dir.hpp"
 #include "io/results.hpp"
 #include "lab/protocol.hpp"
+#include "lab/suite_jobs.hpp"
 #include "materials/material_card.hpp"
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
 #include <thread>
-
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-extern char** environ;
 
 namespace rocklab {
 
@@ -173,73 +165,6 @@ Suite load_suite(const std::string& path) {
 
 namespace {
 
-struct Job {
-  std::string label;
-  std::vector<std::string> argv;
-  std::string log;
-  pid_t pid = -1;
-  int status = -1;
-  double seconds = 0;
-  std::chrono::steady_clock::time_point start;
-};
-
-pid_t spawn(const Job& j) {
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, j.log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  std::vector<char*> args;
-  for (const std::string& a : j.argv)
-    args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0)
-    throw std::runtime_error("cannot start " + j.argv[0] + ": " + std::strerror(rc));
-  return pid;
-}
-
-// Run the jobs, at most `parallel` at once. On interrupt the children (which got the same
-// signal from the terminal, or get SIGINT from here) are waited for.
-void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
-  std::size_t next = 0, running = 0;
-  std::map<pid_t, std::size_t> live;
-  bool stopping = false;
-  while (next < jobs.size() || running > 0) {
-    while (!stopping && running < static_cast<std::size_t>(parallel) && next < jobs.size()) {
-      jobs[next].start = std::chrono::steady_clock::now();
-      jobs[next].pid = spawn(jobs[next]);
-      live[jobs[next].pid] = next;
-      ++running;
-      ++next;
-    }
-    if (running == 0)
-      break;
-    int st = 0;
-    const pid_t pid = waitpid(-1, &st, WNOHANG);
-    if (pid > 0 && live.count(pid)) {
-      Job& j = jobs[live[pid]];
-      live.erase(pid);
-      --running;
-      j.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-      j.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - j.start).count();
-      if (o.progress)
-        std::fprintf(stderr, "[rocklab suite] %s %s in %.1f s\n", j.label.c_str(),
-                     j.status == 0 ? "finished" : "FAILED", j.seconds);
-      continue;
-    }
-    if (!stopping && o.interrupt && o.interrupt->load()) {
-      stopping = true;
-      for (const auto& [p, k] : live)
-        kill(p, SIGINT);
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  if (stopping)
-    throw std::runtime_error("interrupted; nothing was written");
-}
-
 std::string last_lines(const std::string& file, int n) {
   const std::string t = read_text(file);
   std::size_t pos = t.size();
@@ -258,25 +183,31 @@ nlohmann::json or_null(double v) {
 
 } // namespace
 
-nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
-  using clock = std::chrono::steady_clock;
-  const auto t0 = clock::now();
-  OutputDir out(o.out_dir);
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
-  const int parallel = s.parallel > 0 ? s.parallel
-                                      : static_cast<int>(std::min<std::size_t>(
-                                            cores, std::max<std::size_t>(1, s.tests.size())));
-  const int threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(cores) / parallel);
-  const std::string material = fs::absolute(s.material_file).string();
-  fs::create_directories(out.staged("specimens"));
-  fs::create_directories(out.staged("tests"));
-  fs::create_directories(out.staged("logs"));
+namespace {
 
-  // 1. One genesis per specimen shared by several tests.
+// A suite in progress: the staging folder, the process and thread counts, the material.
+struct SuiteRun {
+  SuiteRun(const Suite& suite, const SuiteOptions& options, OutputDir& dir)
+      : s(suite), o(options), out(dir) {}
+
+  const Suite& s;
+  const SuiteOptions& o;
+  OutputDir& out;
+  int parallel = 1, threads = 1;
+  unsigned cores = 1;
+  std::string material;
+
+  std::map<std::string, std::string> make_specimens();
+  std::vector<Job> run_tests(const std::map<std::string, std::string>& specimen_of);
+};
+
+// 1. One genesis per specimen shared by several tests; returns specimen key -> file name under
+// specimens/.
+std::map<std::string, std::string> SuiteRun::make_specimens() {
   std::map<std::string, int> uses;
   for (const SuiteTest& t : s.tests)
     ++uses[t.specimen_key];
-  std::map<std::string, std::string> specimen_of; // key -> file name under specimens/
+  std::map<std::string, std::string> specimen_of;
   std::vector<Job> gen;
   for (const SuiteTest& t : s.tests) {
     if (uses[t.specimen_key] < 2 || specimen_of.count(t.specimen_key))
@@ -307,12 +238,16 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
     if (j.status != 0)
       throw std::runtime_error(s.file + ": " + j.label + " failed:\n" + last_lines(j.log, 5));
 
-  // 2. The tests (a specimen used once is made inside its test).
+  return specimen_of;
+}
+
+// 2. The tests (a specimen used once is made inside its test).
+std::vector<Job> SuiteRun::run_tests(const std::map<std::string, std::string>& specimen_of) {
   std::vector<Job> jobs;
   for (const SuiteTest& t : s.tests) {
     nlohmann::json p = t.protocol;
     if (specimen_of.count(t.specimen_key)) {
-      p["specimen"] = {{"file", "../../specimens/" + specimen_of[t.specimen_key]}};
+      p["specimen"] = {{"file", "../../specimens/" + specimen_of.at(t.specimen_key)}};
       p.erase("seed");
     } else {
       p["specimen"] = {{"material", material}};
@@ -335,70 +270,79 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
   }
   run_jobs(jobs, parallel, o);
 
-  // 3. Summary.
+  return jobs;
+}
+
+// 3. The summary of the tests' results.
+struct SuiteSummary {
   nlohmann::json tests = nlohmann::json::array();
-  std::vector<double> s3, s1;
+  std::vector<double> s3, s1; ///< confinement and peak stress of UCS and triaxial tests [Pa]
   double ucs = std::nan(""), e = std::nan(""), nu = std::nan(""), bts = std::nan(""),
          dt = std::nan("");
   bool failed = false;
   std::string csv = "name,test,status,confinement_Pa,youngs_modulus_Pa,poisson_ratio,"
                     "peak_stress_Pa,peak_deviator_Pa,tensile_strength_Pa,cracks_tension,"
                     "cracks_shear,grains,steps,wall_time_s\n";
-  for (std::size_t k = 0; k < s.tests.size(); ++k) {
-    const SuiteTest& t = s.tests[k];
-    const Job& j = jobs[k];
-    // Move the test's output folder up: tests/NAME/{protocol.json, results.json, ...}.
-    const fs::path dir = out.staged("tests/" + t.name);
-    nlohmann::json row{{"name", t.name}, {"test", t.protocol.value("test", "")}};
-    if (j.status != 0) {
-      failed = true;
-      row["status"] = "failed";
-      row["error"] = last_lines(j.log, 3);
-      tests.push_back(row);
-      csv += t.name + "," + row["test"].get<std::string>() + ",failed,,,,,,,,,,," +
-             format_double(j.seconds) + "\n";
-      continue;
-    }
-    for (const auto& entry : fs::directory_iterator(dir / "out"))
-      fs::rename(entry.path(), dir / entry.path().filename());
-    fs::remove(dir / "out");
-    const nlohmann::json r = read_json_file((dir / "results.json").string());
-    row["status"] = "ok";
-    row["results"] = "tests/" + t.name + "/results.json";
-    const double conf = num(r, "confinement_Pa");
-    row["confinement_Pa"] = or_null(conf);
-    for (const char* key : {"youngs_modulus_Pa", "poisson_ratio", "peak_stress_Pa",
-                            "peak_deviator_Pa", "tensile_strength_Pa"})
-      row[key] = or_null(num(r, key));
-    row["cracks"] = r["cracks"];
-    row["wall_time_s"] = r["provenance"]["wall_time_s"];
-    row["grains"] = r["provenance"]["grains"];
-    row["steps"] = r["provenance"]["steps"];
-    const std::string type = r.value("test", "");
-    if (type == "ucs" || type == "triaxial") {
-      s3.push_back(type == "ucs" ? 0.0 : conf);
-      s1.push_back(num(r, "peak_stress_Pa"));
-    }
-    if (type == "ucs" && std::isnan(ucs)) {
-      ucs = num(r, "peak_stress_Pa");
-      e = num(r, "youngs_modulus_Pa");
-      nu = num(r, "poisson_ratio");
-    }
-    if (type == "brazilian" && std::isnan(bts))
-      bts = num(r, "tensile_strength_Pa");
-    if (type == "direct_tension" && std::isnan(dt))
-      dt = num(r, "tensile_strength_Pa");
-    auto f = [&](const char* key) {
-      const double v = num(r, key);
-      return std::isfinite(v) ? format_double(v) : std::string();
-    };
-    csv += t.name + "," + type + ",ok," + f("confinement_Pa") + "," + f("youngs_modulus_Pa") + "," +
-           f("poisson_ratio") + "," + f("peak_stress_Pa") + "," + f("peak_deviator_Pa") + "," +
-           f("tensile_strength_Pa") + "," + r["cracks"]["tension"].dump() + "," +
-           r["cracks"]["shear"].dump() + "," + r["provenance"]["grains"].dump() + "," +
-           r["provenance"]["steps"].dump() + "," + format_double(j.seconds) + "\n";
+
+  void add(const SuiteTest& t, const Job& j, OutputDir& out);
+  nlohmann::json properties() const;
+};
+
+void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
+  // Move the test's output folder up: tests/NAME/{protocol.json, results.json, ...}.
+  const fs::path dir = out.staged("tests/" + t.name);
+  nlohmann::json row{{"name", t.name}, {"test", t.protocol.value("test", "")}};
+  if (j.status != 0) {
+    failed = true;
+    row["status"] = "failed";
+    row["error"] = last_lines(j.log, 3);
     tests.push_back(row);
+    csv += t.name + "," + row["test"].get<std::string>() + ",failed,,,,,,,,,,," +
+           format_double(j.seconds) + "\n";
+    return;
   }
+  for (const auto& entry : fs::directory_iterator(dir / "out"))
+    fs::rename(entry.path(), dir / entry.path().filename());
+  fs::remove(dir / "out");
+  const nlohmann::json r = read_json_file((dir / "results.json").string());
+  row["status"] = "ok";
+  row["results"] = "tests/" + t.name + "/results.json";
+  const double conf = num(r, "confinement_Pa");
+  row["confinement_Pa"] = or_null(conf);
+  for (const char* key : {"youngs_modulus_Pa", "poisson_ratio", "peak_stress_Pa",
+                          "peak_deviator_Pa", "tensile_strength_Pa"})
+    row[key] = or_null(num(r, key));
+  row["cracks"] = r["cracks"];
+  row["wall_time_s"] = r["provenance"]["wall_time_s"];
+  row["grains"] = r["provenance"]["grains"];
+  row["steps"] = r["provenance"]["steps"];
+  const std::string type = r.value("test", "");
+  if (type == "ucs" || type == "triaxial") {
+    s3.push_back(type == "ucs" ? 0.0 : conf);
+    s1.push_back(num(r, "peak_stress_Pa"));
+  }
+  if (type == "ucs" && std::isnan(ucs)) {
+    ucs = num(r, "peak_stress_Pa");
+    e = num(r, "youngs_modulus_Pa");
+    nu = num(r, "poisson_ratio");
+  }
+  if (type == "brazilian" && std::isnan(bts))
+    bts = num(r, "tensile_strength_Pa");
+  if (type == "direct_tension" && std::isnan(dt))
+    dt = num(r, "tensile_strength_Pa");
+  auto f = [&](const char* key) {
+    const double v = num(r, key);
+    return std::isfinite(v) ? format_double(v) : std::string();
+  };
+  csv += t.name + "," + type + ",ok," + f("confinement_Pa") + "," + f("youngs_modulus_Pa") + "," +
+         f("poisson_ratio") + "," + f("peak_stress_Pa") + "," + f("peak_deviator_Pa") + "," +
+         f("tensile_strength_Pa") + "," + r["cracks"]["tension"].dump() + "," +
+         r["cracks"]["shear"].dump() + "," + r["provenance"]["grains"].dump() + "," +
+         r["provenance"]["steps"].dump() + "," + format_double(j.seconds) + "\n";
+  tests.push_back(row);
+}
+
+nlohmann::json SuiteSummary::properties() const {
   const Envelope env = fit_envelope(s3, s1);
   nlohmann::json props{
       {"youngs_modulus_Pa", or_null(e)},
@@ -415,6 +359,32 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
       {"hoek_brown_mi", env.has_hb ? or_null(env.hb_mi) : nlohmann::json(nullptr)},
       {"hoek_brown_sigma_c_Pa", env.has_hb ? or_null(env.hb_sigma_c) : nlohmann::json(nullptr)},
       {"envelope_points", env.points}};
+  return props;
+}
+
+} // namespace
+
+nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  OutputDir out(o.out_dir);
+  SuiteRun run(s, o, out);
+  run.cores = std::max(1u, std::thread::hardware_concurrency());
+  run.parallel = s.parallel > 0 ? s.parallel
+                                : static_cast<int>(std::min<std::size_t>(
+                                      run.cores, std::max<std::size_t>(1, s.tests.size())));
+  run.threads = o.threads > 0 ? o.threads : std::max(1, static_cast<int>(run.cores) / run.parallel);
+  run.material = fs::absolute(s.material_file).string();
+  fs::create_directories(out.staged("specimens"));
+  fs::create_directories(out.staged("tests"));
+  fs::create_directories(out.staged("logs"));
+  const std::map<std::string, std::string> specimen_of = run.make_specimens();
+  const std::vector<Job> jobs = run.run_tests(specimen_of);
+  SuiteSummary sum;
+  for (std::size_t k = 0; k < s.tests.size(); ++k)
+    sum.add(s.tests[k], jobs[k], out);
+  const nlohmann::json props = sum.properties();
+  const int parallel = run.parallel, threads = run.threads;
   nlohmann::json summary{{"suite", s.name},
                          {"suite_file", s.file},
                          {"suite_hash", s.text_hash},
@@ -422,7 +392,7 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
                          {"material_file", s.material_file},
                          {"units", "SI (m, kg, s, N, Pa, J); stresses compression positive"},
                          {"properties", props},
-                         {"tests", tests},
+                         {"tests", sum.tests},
                          {"parallel_processes", parallel},
                          {"threads_per_process", threads},
                          {"rocklab_version", ROCKLAB_VERSION},
@@ -442,9 +412,9 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
   scsv += "\n";
   write_text_file(out.staged("summary.json"), summary.dump(2) + "\n");
   write_text_file(out.staged("summary.csv"), scsv);
-  write_text_file(out.staged("tests.csv"), csv);
+  write_text_file(out.staged("tests.csv"), sum.csv);
   out.commit();
-  if (failed)
+  if (sum.failed)
     summary["failed"] = true;
   return summary;
 }

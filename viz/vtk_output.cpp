@@ -105,164 +105,173 @@ Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, doubl
   return s;
 }
 
+namespace {
+
+// Points and cells of one polydata file (the set-up every series but the grains shares).
+struct PolyBuilder {
+  vtkNew<vtkPoints> pts;
+  vtkNew<vtkCellArray> cells;
+  vtkNew<vtkPolyData> pd;
+
+  PolyBuilder() { pts->SetDataTypeToDouble(); }
+  vtkIdType point(const Vec3& x) { return pts->InsertNextPoint(x.x(), x.y(), x.z()); }
+  /// The cells are lines (2D pictures, bonds) or polygons.
+  void write(const std::filesystem::path& path, bool as_lines) {
+    pd->SetPoints(pts);
+    if (as_lines)
+      pd->SetLines(cells);
+    else
+      pd->SetPolys(cells);
+    write_poly(pd, path);
+  }
+  template <class T, class Arr> void cell_array(const char* name, const std::vector<T>& v) {
+    pd->GetCellData()->AddArray(scalar_array<T, Arr>(name, v));
+  }
+};
+
+// Grains: one vertex cell per grain.
+void write_grains(const Snapshot& s, const std::filesystem::path& path) {
+  const auto n = static_cast<vtkIdType>(s.pos.size());
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(n);
+  for (vtkIdType i = 0; i < n; ++i) {
+    const Vec3& x = s.pos[static_cast<std::size_t>(i)];
+    pts->SetPoint(i, x.x(), x.y(), x.z());
+  }
+  vtkNew<vtkUnstructuredGrid> ug;
+  ug->SetPoints(pts);
+  ug->Allocate(n);
+  for (vtkIdType i = 0; i < n; ++i)
+    ug->InsertNextCell(VTK_VERTEX, 1, &i);
+  vtkPointData* pd = ug->GetPointData();
+  pd->AddArray(scalar_array<double, vtkDoubleArray>("radius", s.radius));
+  pd->AddArray(vector_array("velocity", s.vel));
+  pd->AddArray(vector_array("displacement", s.disp));
+  pd->AddArray(scalar_array<std::int32_t, vtkIntArray>("group", s.group));
+  pd->AddArray(scalar_array<std::int64_t, vtkLongLongArray>("id", s.id));
+  vtkNew<vtkXMLUnstructuredGridWriter> w;
+  w->SetFileName(path.string().c_str());
+  w->SetInputData(ug);
+  w->SetDataModeToAppended();
+  w->EncodeAppendedDataOff();
+  if (w->Write() != 1)
+    throw std::runtime_error(path.string() + ": VTK could not write the file");
+}
+
+// Bonds: a line between the grain centres.
+void write_bonds(const Snapshot& s, const std::filesystem::path& path) {
+  PolyBuilder b;
+  for (const auto& e : s.bond_ends) {
+    const vtkIdType ids[2] = {b.point(e[0]), b.point(e[1])};
+    b.cells->InsertNextCell(2, ids);
+  }
+  b.cell_array<std::int32_t, vtkIntArray>("bond_state", s.bond_state);
+  b.cell_array<double, vtkDoubleArray>("broken_fraction", s.broken_fraction);
+  b.cell_array<std::int32_t, vtkIntArray>("model", s.bond_model);
+  b.write(path, true);
+}
+
+// Cracks: 3D disks as 16-gons, 2D segments in the xy plane.
+void write_cracks(const Snapshot& s, const std::filesystem::path& path) {
+  PolyBuilder b;
+  std::vector<std::int32_t> mode;
+  std::vector<double> time, size;
+  for (const CrackGlyph& c : s.cracks) {
+    const double r = 0.5 * c.size;
+    if (s.dim == 2) {
+      const Vec3 t(-c.normal.y(), c.normal.x(), 0);
+      const vtkIdType ids[2] = {b.point(c.position - r * t), b.point(c.position + r * t)};
+      b.cells->InsertNextCell(2, ids);
+    } else {
+      Vec3 u, v;
+      plane_axes(c.normal, u, v);
+      constexpr int kSides = 16;
+      vtkIdType ids[kSides];
+      for (int k = 0; k < kSides; ++k) {
+        const double a = 2 * kPi * k / kSides;
+        ids[k] = b.point(c.position + r * (std::cos(a) * u + std::sin(a) * v));
+      }
+      b.cells->InsertNextCell(kSides, ids);
+    }
+    mode.push_back(c.mode);
+    time.push_back(c.time);
+    size.push_back(c.size);
+  }
+  b.cell_array<std::int32_t, vtkIntArray>("mode", mode);
+  b.cell_array<double, vtkDoubleArray>("time", time);
+  b.cell_array<double, vtkDoubleArray>("size", size);
+  b.write(path, s.dim == 2);
+}
+
+// A cylinder wall as a 48-sided prism (2D: a polygon of segments).
+void add_cylinder(PolyBuilder& b, const Wall& wall, int dim, double extent) {
+  constexpr int kSides = 48;
+  Vec3 u, v;
+  plane_axes(wall.axis, u, v);
+  const double h = wall.half_height > 0 ? wall.half_height : 0.5 * extent;
+  for (int k = 0; k < kSides; ++k) {
+    const double a0 = 2 * kPi * k / kSides, a1 = 2 * kPi * (k + 1) / kSides;
+    const Vec3 r0 = wall.cylinder_radius * (std::cos(a0) * u + std::sin(a0) * v);
+    const Vec3 r1 = wall.cylinder_radius * (std::cos(a1) * u + std::sin(a1) * v);
+    if (dim == 2) {
+      const Vec3 p0 = wall.center + r0, p1 = wall.center + r1;
+      const vtkIdType ids[2] = {b.point(Vec3(p0.x(), p0.y(), 0)), b.point(Vec3(p1.x(), p1.y(), 0))};
+      b.cells->InsertNextCell(2, ids);
+    } else {
+      const Vec3 lo = wall.center - h * wall.axis, hi = wall.center + h * wall.axis;
+      const Vec3 q[4] = {lo + r0, lo + r1, hi + r1, hi + r0};
+      vtkIdType ids[4];
+      for (int i = 0; i < 4; ++i)
+        ids[i] = b.point(q[i]);
+      b.cells->InsertNextCell(4, ids);
+    }
+  }
+}
+
+// Walls: facets (segments in 2D), cylinders as prisms or polygons.
+void write_walls(const Snapshot& s, const std::filesystem::path& path) {
+  PolyBuilder b;
+  std::vector<std::int32_t> wall_index;
+  for (std::size_t w = 0; w < s.walls.size(); ++w) {
+    const Wall& wall = s.walls[w];
+    if (wall.is_cylinder()) {
+      add_cylinder(b, wall, s.dim, s.wall_extent);
+      wall_index.insert(wall_index.end(), 48, static_cast<std::int32_t>(w));
+      continue;
+    }
+    for (const Facet& f : wall.facets) {
+      vtkIdType ids[3];
+      for (int k = 0; k < f.nv; ++k)
+        ids[k] = b.point(f.v[k]);
+      b.cells->InsertNextCell(f.nv, ids);
+      wall_index.push_back(static_cast<std::int32_t>(w));
+    }
+  }
+  b.cell_array<std::int32_t, vtkIntArray>("wall", wall_index);
+  b.write(path, s.dim == 2);
+}
+
+} // namespace
+
 std::vector<std::string> VtkSeries::write(const Snapshot& s, const std::string& tag) {
   std::filesystem::create_directories(dir_);
   char index[32];
   std::snprintf(index, sizeof index, "%04d", count());
   if (!tag.empty())
     std::snprintf(index, sizeof index, "%s", tag.c_str());
-  const std::string gname = std::string("grains_") + index + ".vtu";
-  const std::string bname = std::string("bonds_") + index + ".vtp";
-  const std::string cname = std::string("cracks_") + index + ".vtp";
-  const std::string wname = std::string("walls_") + index + ".vtp";
-  const auto n = static_cast<vtkIdType>(s.pos.size());
-
-  { // grains: one vertex cell per grain
-    vtkNew<vtkPoints> pts;
-    pts->SetDataTypeToDouble();
-    pts->SetNumberOfPoints(n);
-    for (vtkIdType i = 0; i < n; ++i) {
-      const Vec3& x = s.pos[static_cast<std::size_t>(i)];
-      pts->SetPoint(i, x.x(), x.y(), x.z());
-    }
-    vtkNew<vtkUnstructuredGrid> ug;
-    ug->SetPoints(pts);
-    ug->Allocate(n);
-    for (vtkIdType i = 0; i < n; ++i)
-      ug->InsertNextCell(VTK_VERTEX, 1, &i);
-    vtkPointData* pd = ug->GetPointData();
-    pd->AddArray(scalar_array<double, vtkDoubleArray>("radius", s.radius));
-    pd->AddArray(vector_array("velocity", s.vel));
-    pd->AddArray(vector_array("displacement", s.disp));
-    pd->AddArray(scalar_array<std::int32_t, vtkIntArray>("group", s.group));
-    pd->AddArray(scalar_array<std::int64_t, vtkLongLongArray>("id", s.id));
-    vtkNew<vtkXMLUnstructuredGridWriter> w;
-    w->SetFileName((dir_ / gname).string().c_str());
-    w->SetInputData(ug);
-    w->SetDataModeToAppended();
-    w->EncodeAppendedDataOff();
-    if (w->Write() != 1)
-      throw std::runtime_error((dir_ / gname).string() + ": VTK could not write the file");
-  }
-  { // bonds: a line between the grain centres
-    vtkNew<vtkPoints> pts;
-    pts->SetDataTypeToDouble();
-    vtkNew<vtkCellArray> lines;
-    for (const auto& e : s.bond_ends) {
-      const vtkIdType a = pts->InsertNextPoint(e[0].x(), e[0].y(), e[0].z());
-      const vtkIdType b = pts->InsertNextPoint(e[1].x(), e[1].y(), e[1].z());
-      const vtkIdType ids[2] = {a, b};
-      lines->InsertNextCell(2, ids);
-    }
-    vtkNew<vtkPolyData> pd;
-    pd->SetPoints(pts);
-    pd->SetLines(lines);
-    pd->GetCellData()->AddArray(
-        scalar_array<std::int32_t, vtkIntArray>("bond_state", s.bond_state));
-    pd->GetCellData()->AddArray(
-        scalar_array<double, vtkDoubleArray>("broken_fraction", s.broken_fraction));
-    pd->GetCellData()->AddArray(scalar_array<std::int32_t, vtkIntArray>("model", s.bond_model));
-    write_poly(pd, dir_ / bname);
-  }
-  { // cracks: 3D disks as 16-gons, 2D segments in the xy plane
-    vtkNew<vtkPoints> pts;
-    pts->SetDataTypeToDouble();
-    vtkNew<vtkCellArray> polys, lines;
-    std::vector<std::int32_t> mode;
-    std::vector<double> time, size;
-    for (const CrackGlyph& c : s.cracks) {
-      const double r = 0.5 * c.size;
-      if (s.dim == 2) {
-        const Vec3 t(-c.normal.y(), c.normal.x(), 0);
-        const Vec3 a = c.position - r * t, b = c.position + r * t;
-        const vtkIdType ids[2] = {pts->InsertNextPoint(a.x(), a.y(), a.z()),
-                                  pts->InsertNextPoint(b.x(), b.y(), b.z())};
-        lines->InsertNextCell(2, ids);
-      } else {
-        Vec3 u, v;
-        plane_axes(c.normal, u, v);
-        constexpr int kSides = 16;
-        vtkIdType ids[kSides];
-        for (int k = 0; k < kSides; ++k) {
-          const double a = 2 * kPi * k / kSides;
-          const Vec3 p = c.position + r * (std::cos(a) * u + std::sin(a) * v);
-          ids[k] = pts->InsertNextPoint(p.x(), p.y(), p.z());
-        }
-        polys->InsertNextCell(kSides, ids);
-      }
-      mode.push_back(c.mode);
-      time.push_back(c.time);
-      size.push_back(c.size);
-    }
-    vtkNew<vtkPolyData> pd;
-    pd->SetPoints(pts);
-    if (s.dim == 2)
-      pd->SetLines(lines);
-    else
-      pd->SetPolys(polys);
-    pd->GetCellData()->AddArray(scalar_array<std::int32_t, vtkIntArray>("mode", mode));
-    pd->GetCellData()->AddArray(scalar_array<double, vtkDoubleArray>("time", time));
-    pd->GetCellData()->AddArray(scalar_array<double, vtkDoubleArray>("size", size));
-    write_poly(pd, dir_ / cname);
-  }
-  { // walls: facets (segments in 2D), cylinders as 48-sided prisms or polygons
-    vtkNew<vtkPoints> pts;
-    pts->SetDataTypeToDouble();
-    vtkNew<vtkCellArray> polys, lines;
-    std::vector<std::int32_t> wall_index;
-    for (std::size_t w = 0; w < s.walls.size(); ++w) {
-      const Wall& wall = s.walls[w];
-      if (wall.is_cylinder()) {
-        constexpr int kSides = 48;
-        Vec3 u, v;
-        plane_axes(wall.axis, u, v);
-        const double h = wall.half_height > 0 ? wall.half_height : 0.5 * s.wall_extent;
-        for (int k = 0; k < kSides; ++k) {
-          const double a0 = 2 * kPi * k / kSides, a1 = 2 * kPi * (k + 1) / kSides;
-          const Vec3 r0 = wall.cylinder_radius * (std::cos(a0) * u + std::sin(a0) * v);
-          const Vec3 r1 = wall.cylinder_radius * (std::cos(a1) * u + std::sin(a1) * v);
-          if (s.dim == 2) {
-            const Vec3 p0 = wall.center + r0, p1 = wall.center + r1;
-            const vtkIdType ids[2] = {pts->InsertNextPoint(p0.x(), p0.y(), 0),
-                                      pts->InsertNextPoint(p1.x(), p1.y(), 0)};
-            lines->InsertNextCell(2, ids);
-          } else {
-            const Vec3 lo = wall.center - h * wall.axis, hi = wall.center + h * wall.axis;
-            const Vec3 q[4] = {lo + r0, lo + r1, hi + r1, hi + r0};
-            vtkIdType ids[4];
-            for (int i = 0; i < 4; ++i)
-              ids[i] = pts->InsertNextPoint(q[i].x(), q[i].y(), q[i].z());
-            polys->InsertNextCell(4, ids);
-          }
-          wall_index.push_back(static_cast<std::int32_t>(w));
-        }
-        continue;
-      }
-      for (const Facet& f : wall.facets) {
-        vtkIdType ids[3];
-        for (int k = 0; k < f.nv; ++k)
-          ids[k] = pts->InsertNextPoint(f.v[k].x(), f.v[k].y(), f.v[k].z());
-        if (f.nv == 2)
-          lines->InsertNextCell(2, ids);
-        else
-          polys->InsertNextCell(3, ids);
-        wall_index.push_back(static_cast<std::int32_t>(w));
-      }
-    }
-    vtkNew<vtkPolyData> pd;
-    pd->SetPoints(pts);
-    if (s.dim == 2)
-      pd->SetLines(lines);
-    else
-      pd->SetPolys(polys);
-    pd->GetCellData()->AddArray(scalar_array<std::int32_t, vtkIntArray>("wall", wall_index));
-    write_poly(pd, dir_ / wname);
-  }
+  const std::vector<std::string> names = {
+      std::string("grains_") + index + ".vtu", std::string("bonds_") + index + ".vtp",
+      std::string("cracks_") + index + ".vtp", std::string("walls_") + index + ".vtp"};
+  write_grains(s, dir_ / names[0]);
+  write_bonds(s, dir_ / names[1]);
+  write_cracks(s, dir_ / names[2]);
+  write_walls(s, dir_ / names[3]);
   if (tag.empty())
     times_.push_back(s.time);
   else
     tagged_[tag] = s.time;
-  return {gname, bname, cname, wname};
+  return names;
 }
 
 std::vector<std::string> VtkSeries::write_collections() const {

@@ -173,6 +173,23 @@ int suite_command(const std::string& suite_file, const std::string& out_dir, boo
   return sm.value("failed", false) ? 1 : 0;
 }
 
+int info_command() {
+  std::string models, tests;
+  for (const std::string& name : rocklab::model_names()) {
+    if (!models.empty())
+      models += ", ";
+    models += name;
+  }
+  for (const std::string& name : rocklab::lab_protocol_names()) {
+    if (!tests.empty())
+      tests += ", ";
+    tests += name;
+  }
+  std::printf("rocklab %s\nthreads %d\ncontact models: %s\nlab tests: %s\nunits: SI\n",
+              ROCKLAB_VERSION, omp_get_max_threads(), models.c_str(), tests.c_str());
+  return 0;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -239,7 +256,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   suite->add_flag("-q,--quiet", quiet, "No progress and no summary");
 
-  CLI::App* info = app.add_subcommand("info", "Print the version, threads and contact models");
+  CLI::App* info =
+      app.add_subcommand("info", "Print the version, threads, contact models and lab tests");
 
   CLI11_PARSE(app, argc, argv);
   if (threads > 0 && !*suite)
@@ -256,17 +274,8 @@ int main(int argc, char** argv) {
       return suite_command(suite_file, suite_out, quiet, threads);
     if (*test)
       return test_command(protocol_file, test_out, quiet, checkpoint_every, resume);
-    if (*info) {
-      std::string models;
-      for (const std::string& name : rocklab::model_names()) {
-        if (!models.empty())
-          models += ", ";
-        models += name;
-      }
-      std::printf("rocklab %s\nthreads %d\ncontact models: %s\nunits: SI\n", ROCKLAB_VERSION,
-                  omp_get_max_threads(), models.c_str());
-      return 0;
-    }
+    if (*info)
+      return info_command();
   } catch (const rocklab::InputError& e) {
     std::fprintf(stderr, "rocklab: input error: %s\n", e.what());
     return 2;

@@ -1,0 +1,29 @@
+// The processes of a suite: each genesis and each test runs as its own `rocklab` process (a
+// failed or killed test cannot take the others down), at most `parallel` at once.
+#pragma once
+
+#include "lab/suite.hpp"
+
+#include <chrono>
+#include <string>
+#include <sys/types.h>
+#include <vector>
+
+namespace rocklab {
+
+struct Job {
+  std::string label;
+  std::vector<std::string> argv;
+  std::string log;
+  pid_t pid = -1;
+  int status = -1;
+  double seconds = 0;
+  std::chrono::steady_clock::time_point start;
+};
+
+/// Run the jobs, at most `parallel` at once; fills each job's status and seconds. On interrupt
+/// the children (which got the same signal from the terminal, or get SIGINT from here) are waited
+/// for and the suite fails.
+void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o);
+
+} // namespace rocklab
