@@ -5,6 +5,7 @@
 
 #include "lab/protocols/frame_test.hpp"
 
+#include <cassert>
 #include <cmath>
 #include <numbers>
 
@@ -15,6 +16,7 @@ constexpr double kPi = std::numbers::pi;
 }
 
 double LoadingFrame::separation() const {
+  assert((top_ >= 0 || !grip_top_.empty()) && "the frame has platens or grips");
   const int axis = geo_.axis;
   if (top_ >= 0)
     return m_.walls[static_cast<std::size_t>(top_)].center[axis] -

@@ -131,6 +131,8 @@ std::vector<double> fragment_masses(const Model& m) {
 /// (a departure after which the rock rises by 2 % of its smallest radius, or turns down, without
 /// touching again).
 struct Bounce {
+  Bounce(const Vec3& up_axis, double min_radius) : up(up_axis), rmin(min_radius) {}
+
   Vec3 up;
   double rmin;
   bool touched = false, was = false, candidate = false, done = false;
@@ -189,7 +191,7 @@ DropResult run_drop(const DropProtocol& p, double speed, double exponent, std::s
   EnergyLedger e0 = m.energy();
   Vec3 prev_vel = c.vel;
   double prev_ke = c.ke;
-  Bounce b{up, rmin};
+  Bounce b(up, rmin);
   auto row = [&] {
     if (!history)
       return;

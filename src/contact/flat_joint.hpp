@@ -7,6 +7,7 @@
 #include "io/input_error.hpp"
 
 #include <array>
+#include <cassert>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -98,9 +99,11 @@ struct FlatJointElements {
   std::vector<FlatJointElement> all;
 
   std::span<FlatJointElement> of(const FlatJointContact& c) {
+    assert(std::size_t{c.elem} + c.n_elem <= all.size() && "flat-joint elements outside the pool");
     return {all.data() + c.elem, c.n_elem};
   }
   std::span<const FlatJointElement> of(const FlatJointContact& c) const {
+    assert(std::size_t{c.elem} + c.n_elem <= all.size() && "flat-joint elements outside the pool");
     return {all.data() + c.elem, c.n_elem};
   }
   void clear() { all.clear(); }

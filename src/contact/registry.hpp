@@ -12,6 +12,7 @@
 #include "contact/power_plastic.hpp"
 #include "contact/smooth_joint.hpp"
 
+#include <cassert>
 #include <cstddef>
 #include <span>
 #include <string_view>
@@ -91,6 +92,8 @@ template <class M> constexpr bool allows_ball_facet() {
 
 /// Call f.template operator()<M>() with the model of kind k.
 template <std::size_t I = 0, class F> decltype(auto) visit_model(ModelKind k, F&& f) {
+  if constexpr (I == 0)
+    assert(static_cast<std::size_t>(k) < kModelCount && "contact model kind out of range");
   if constexpr (I + 1 == kModelCount) {
     return f.template operator()<ModelAt<I>>();
   } else {
@@ -140,6 +143,7 @@ struct ModelBatches {
 
 /// Call f(contact) or, for a model with a pool, f(contact, the contact's part of the pool).
 template <class M, class B, class F> decltype(auto) with_contact(B& b, std::uint32_t slot, F&& f) {
+  assert(slot < b.contacts.size() && "contact slot out of its batch");
   auto& c = b.contacts[slot];
   if constexpr (HasPool<M>)
     return f(c, b.pool.of(c));

@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
+#include <functional>
 #include <limits>
 #include <omp.h>
 
@@ -163,6 +165,13 @@ void Model::gather_candidates(const CellGrid& g) {
 
 void Model::merge_candidates() {
   // Merge the candidates with the existing contacts (both sorted by key) into fresh arrays.
+  assert(std::adjacent_find(candidate_keys_.begin(), candidate_keys_.end(),
+                            std::greater_equal<>()) == candidate_keys_.end() &&
+         "candidate keys sorted and unique");
+  assert(std::adjacent_find(contacts_.begin(), contacts_.end(),
+                            [](const Contact& x, const Contact& y) { return x.key >= y.key; }) ==
+             contacts_.end() &&
+         "contacts sorted by key");
   new_contacts_.clear();
   new_outputs_.clear();
   new_batches_.clear();
@@ -210,6 +219,7 @@ void Model::retire_contact(std::size_t ci) {
 
 void Model::create_contact(std::uint64_t key) {
   const ContactEnds ends = contact_ends(key);
+  assert(contact_key(ends.kind, ends.end1, ends.end2) == key && "a key decodes to its ends");
   const std::int32_t end1 = ends.end1, end2 = ends.end2;
   const bool facet = ends.kind == ContactKind::BallFacet;
   const ModelRule* rule = nullptr;
