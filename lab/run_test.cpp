@@ -186,12 +186,36 @@ bool FrameRun::loop() {
   return true;
 }
 
+// The crack-initiation and crack-damage stresses on the axial curve, where results.json has them.
+std::vector<PlotMarker> crack_markers(const LoadingFrame& f, const nlohmann::json& r) {
+  std::vector<PlotMarker> m;
+  if (!r.contains("crack_stresses"))
+    return m;
+  const nlohmann::json& c = r["crack_stresses"];
+  auto add = [&](const char* stress, const char* strain, const char* label) {
+    if (!r[stress].is_number() || !c[strain].is_number())
+      return;
+    const double eps = c[strain].get<double>();
+    for (const LabSample& s : f.samples()) // the axial stress at that point (the deviator's peer)
+      if (s.axial_strain >= eps) {
+        m.push_back({100 * eps, 1e-6 * s.axial_stress, label});
+        return;
+      }
+  };
+  add("crack_initiation_stress_Pa", "crack_initiation_axial_strain", "CI (crack count)");
+  add("crack_initiation_stress_volumetric_Pa", "crack_initiation_volumetric_axial_strain",
+      "CI (crack volumetric strain)");
+  add("crack_damage_stress_Pa", "crack_damage_axial_strain", "CD (volume reversal)");
+  return m;
+}
+
 // Stress-strain plot with crack counts; crack map of the final state.
 void write_plots(const FrameTest& test, const LoadingFrame& f, const nlohmann::json& meta,
-                 OutputDir& out, std::vector<std::string>& files) {
+                 const nlohmann::json& r, OutputDir& out, std::vector<std::string>& files) {
   const PlotLabels labels = test.plot_labels();
   PlotSeries axial{"axial stress vs axial strain", {}, {}, "#000000"};
   PlotSeries lateral{"axial stress vs lateral strain", {}, {}, "#7f7f7f", true};
+  PlotSeries volumetric{"axial stress vs volumetric strain", {}, {}, "#2ca02c", true};
   PlotSeries ct{"tensile cracks", {}, {}, "#d62728", false, true};
   PlotSeries cs{"shear cracks", {}, {}, "#1f3fbf", false, true};
   std::size_t crack_i = 0;
@@ -209,17 +233,20 @@ void write_plots(const FrameTest& test, const LoadingFrame& f, const nlohmann::j
     if (labels.lateral) {
       lateral.x.push_back(100 * s.lateral_strain);
       lateral.y.push_back(1e-6 * s.axial_stress);
+      volumetric.x.push_back(100 *
+                             (s.axial_strain + (f.geometry().dim == 2 ? 1 : 2) * s.lateral_strain));
+      volumetric.y.push_back(1e-6 * s.axial_stress);
     }
   }
   std::vector<PlotSeries> series{axial};
   if (!lateral.x.empty())
-    series.push_back(lateral);
+    series.insert(series.end(), {lateral, volumetric});
   series.push_back(ct);
   series.push_back(cs);
   const std::string title =
       std::string(test.name()) + " test: " + meta.value("material_name", std::string("specimen"));
   write_text_file(out.staged("stress_strain.svg"),
-                  line_plot_svg(title, labels.x, labels.y, "cracks", series));
+                  line_plot_svg(title, labels.x, labels.y, "cracks", series, crack_markers(f, r)));
   write_text_file(out.staged("crack_map.svg"),
                   crack_map_svg(frame_snapshot(f), title + ", cracks at the end", labels.map_axis));
   files.insert(files.end(), {"stress_strain.svg", "crack_map.svg"});
@@ -255,7 +282,7 @@ void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::t
   write_text_file(out.staged("cracks.csv"), f.cracks().csv());
   sum.files.insert(sum.files.end(), {"results.json", "history.csv", "cracks.csv"});
   if (p.plots)
-    write_plots(test, f, meta, out, sum.files);
+    write_plots(test, f, meta, r, out, sum.files);
   r["files"] = sum.files;
   sum.results = r;
   write_text_file(out.staged("results.json"), r.dump(2) + "\n");
@@ -297,7 +324,9 @@ LabSummary FrameTest::run(const nlohmann::json&, const std::string& file, const 
 
 void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
   const nlohmann::json& r = s.results;
-  auto mpa = [&](const char* key) { return r.contains(key) ? r[key].get<double>() * 1e-6 : 0.0; };
+  auto mpa = [&](const char* key) {
+    return r.contains(key) && r[key].is_number() ? r[key].get<double>() * 1e-6 : 0.0;
+  };
   std::printf("test         %s   material %s   grains %lld   steps %lld\n",
               r["test"].get<std::string>().c_str(),
               r["provenance"]["material"].get<std::string>().c_str(),
@@ -307,9 +336,20 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
     std::printf("peak stress  %.4g MPa (deviator %.4g MPa) at axial strain %.4g %%\n",
                 mpa("peak_stress_Pa"), mpa("peak_deviator_Pa"),
                 100 * r["peak_axial_strain"].get<double>());
-    std::printf("E            %.4g GPa tangent at 50 %% of peak, %.4g GPa secant   poisson %.3f\n",
+    std::printf("E            %.4g GPa over the linear window, %.4g GPa secant at 50 %% of peak"
+                "   poisson %.3f\n",
                 1e-3 * mpa("youngs_modulus_Pa"), 1e-3 * mpa("youngs_modulus_secant_Pa"),
                 r["poisson_ratio"].get<double>());
+    auto ratio = [&](const char* key) {
+      const nlohmann::json& v = r["crack_stresses"][key];
+      return v.is_number() ? v.get<double>() : 0.0;
+    };
+    if (r.contains("crack_stresses"))
+      std::printf("crack stress initiation %.4g MPa (%.2f of peak; volumetric %.4g MPa), damage "
+                  "%.4g MPa (%.2f)\n",
+                  mpa("crack_initiation_stress_Pa"), ratio("crack_initiation_ratio"),
+                  mpa("crack_initiation_stress_volumetric_Pa"), mpa("crack_damage_stress_Pa"),
+                  ratio("crack_damage_ratio"));
     if (r.value("confinement_Pa", 0.0) > 0)
       std::printf("confinement  %.4g MPa (held between %.4g and %.4g MPa)\n", mpa("confinement_Pa"),
                   1e-6 * r["confinement_measured_Pa"]["min"].get<double>(),

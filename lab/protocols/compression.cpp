@@ -1,5 +1,6 @@
 #include "lab/protocols/compression.hpp"
 
+#include "lab/frame/curve_analysis.hpp"
 #include "lab/frame/elastic_fit.hpp"
 
 namespace rocklab {
@@ -36,27 +37,35 @@ void unloading_moduli(const LoadingFrame& f, nlohmann::json& r) {
 
 } // namespace
 
+CurveInput CompressionTest::curve(const LoadingFrame& f) {
+  CurveInput in;
+  in.dim = f.geometry().dim;
+  in.load_ref = f.load_ref();
+  in.peak = f.peak().load;
+  const auto& cracks = f.cracks().cracks();
+  std::size_t k = 0;
+  for (const LabSample& s : f.samples()) {
+    if (s.step > f.peak().step)
+      break;
+    while (k < cracks.size() && cracks[k].step <= s.step)
+      ++k;
+    in.samples.push_back(s);
+    in.cracks.push_back(static_cast<std::int64_t>(k));
+  }
+  return in;
+}
+
 void CompressionTest::results(const LoadingFrame& f, nlohmann::json& r) const {
   const PeakRecord& peak = f.peak();
   const std::vector<LabSample>& samples = f.samples();
-  // Tangent modulus and Poisson's ratio at 40-60 % of the peak, secant at 50 %, initial over
-  // the first 1 % of the peak load.
-  const ElasticFit tangent = fit_elastic(samples, peak.load, 0.4, 0.6);
-  double secant = 0;
-  for (const LabSample& s : samples)
-    if (s.load >= 0.5 * peak.load && s.axial_strain > 0) {
-      secant = (s.load - f.load_ref()) / s.axial_strain;
-      break;
-    }
+  // Elastic constants over the linear window, ISRM tangent and secant at 50 %, crack stresses
+  // (lab/frame/curve_analysis.hpp); the initial modulus over the first 1 % of the peak load.
+  write_curve_results(analyse_curve(curve(f)), peak.load, r);
   std::vector<LabSample> early;
   for (const LabSample& s : samples)
     if (s.load - f.load_ref() <= 0.01 * peak.load && s.step <= peak.step)
       early.push_back(s);
-  const ElasticFit initial = fit_elastic(early, 1e300, -1e300, 1e300);
-  r["youngs_modulus_Pa"] = tangent.youngs_modulus;
-  r["youngs_modulus_secant_Pa"] = secant;
-  r["youngs_modulus_initial_Pa"] = initial.youngs_modulus;
-  r["poisson_ratio"] = tangent.poisson_ratio;
+  r["youngs_modulus_initial_Pa"] = fit_elastic(early, 1e300, -1e300, 1e300).youngs_modulus;
   r["peak_stress_Pa"] = peak.stress;
   r["peak_deviator_Pa"] = peak.load;
   r["peak_axial_strain"] = peak.strain;

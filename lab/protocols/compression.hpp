@@ -4,6 +4,7 @@
 // lateral strain. Units SI.
 #pragma once
 
+#include "lab/frame/curve_analysis.hpp"
 #include "lab/protocols/frame_test.hpp"
 
 namespace rocklab {
@@ -14,6 +15,9 @@ public:
   void stresses(const LoadingFrame& f, LabSample& s) const override;
   void results(const LoadingFrame& f, nlohmann::json& r) const override;
   PlotLabels plot_labels() const override;
+
+  /// The loading branch up to the peak with the crack count at each sample.
+  static CurveInput curve(const LoadingFrame& f);
 };
 
 } // namespace rocklab

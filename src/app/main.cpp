@@ -149,6 +149,11 @@ int test_command(const std::string& protocol_file, const std::string& out_dir, b
   }
   if (!quiet)
     test->print(s, out_dir);
+  // Doubtful or impossible measurements are never silent, even with --quiet.
+  std::fflush(stdout);
+  if (s.results.contains("warnings"))
+    for (const auto& w : s.results["warnings"])
+      std::fprintf(stderr, "rocklab: warning: %s\n", w.get<std::string>().c_str());
   return 0;
 }
 
