@@ -146,4 +146,26 @@ TEST(CurveAnalysis, TwentyByFortyGraniteUcsGivesAPhysicalPoissonRatio) {
   EXPECT_GT(ci, 0.1 * peak);
   EXPECT_LT(ci, cd);
   EXPECT_LT(cd, peak);
+  // The energy ledger of the loading closes, and its bond-break term is the energy of the cracks.
+  const nlohmann::json& e = r["energy_J"];
+  EXPECT_LT(std::abs(e["balance_error_relative"].get<double>()), 0.01);
+  EXPECT_GT(e["boundary_work"].get<double>(), 0.0);
+  double crack_energy = 0;
+  std::ifstream cracks(dir / "out" / "cracks.csv");
+  std::string line;
+  std::getline(cracks, line);
+  ASSERT_EQ(line.substr(line.rfind(',') + 1), "energy_J");
+  while (std::getline(cracks, line))
+    crack_energy += std::stod(line.substr(line.rfind(',') + 1));
+  EXPECT_GT(crack_energy, 0.0);
+  EXPECT_NEAR(e["bond_break"].get<double>(), crack_energy, 1e-9 * crack_energy);
+  // history.csv counts from the loading: the last row is the results' ledger.
+  std::ifstream hist(dir / "out" / "history.csv");
+  std::string header, last;
+  std::getline(hist, header);
+  while (std::getline(hist, line))
+    last = line;
+  EXPECT_NE(header.find("bond_break_J,body_work_J,boundary_work_J,balance_error_J"),
+            std::string::npos);
+  EXPECT_NEAR(std::stod(last.substr(last.rfind(',') + 1)), e["balance_error"].get<double>(), 1e-9);
 }

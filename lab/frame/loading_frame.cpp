@@ -48,6 +48,36 @@ nlohmann::json ConfinementBand::json(double) const {
           {"instantaneous_max", inst_max}};
 }
 
+namespace {
+
+constexpr std::size_t kMeasured = 13; // history columns before the energy ledger
+
+std::vector<double> ledger_values(EnergyLedger e) {
+  std::vector<double> v;
+  e.terms([&](double& x) { v.push_back(x); });
+  return v;
+}
+
+EnergyLedger ledger_from(const double* v) {
+  EnergyLedger e;
+  int i = 0;
+  e.terms([&](double& x) { x = v[i++]; });
+  return e;
+}
+
+} // namespace
+
+void LoadingFrame::mark_energy_start() {
+  energy_start_ = ledger_values(m_.energy());
+}
+
+EnergyLedger LoadingFrame::energy_since_loading() const {
+  const std::vector<double>& ref = energy_load_.empty() ? energy_start_ : energy_load_;
+  if (ref.size() != EnergyLedger::kTerms)
+    return m_.energy();
+  return m_.energy().since(ledger_from(ref.data()));
+}
+
 const char* LoadingFrame::phase_name() const {
   static const char* names[] = {"confining", "seating", "loading", "unloading", "done"};
   return names[phase_];
@@ -56,6 +86,7 @@ const char* LoadingFrame::phase_name() const {
 void LoadingFrame::begin_loading() {
   phase_ = kLoad;
   load_start_step_ = phase_start_step_ = m_.step();
+  energy_load_ = ledger_values(m_.energy());
   sep_ref_ = separation();
   shell_ref_.clear();
   for (std::int32_t i : shell_)
@@ -78,30 +109,52 @@ void LoadingFrame::begin_loading() {
 }
 
 void LoadingFrame::record_history() {
-  const EnergyLedger en = m_.energy();
   const LabSample& s = current_;
   const double vol =
       s.axial_strain + (geo_.dim == 2 ? 1.0 : 2.0) * s.lateral_strain; // compression positive
-  history_.push_back({s.time, static_cast<double>(s.step), static_cast<double>(phase_),
-                      s.axial_strain, s.lateral_strain, vol, s.axial_stress, s.lateral_stress,
-                      s.load, s.force, static_cast<double>(monitor_.tension()),
-                      static_cast<double>(monitor_.shear()), static_cast<double>(monitor_.total()),
-                      en.kinetic(), en.strain, en.bond_strain, en.slip, en.local_damping,
-                      en.boundary_work});
+  std::vector<double> row{s.time,
+                          static_cast<double>(s.step),
+                          static_cast<double>(phase_),
+                          s.axial_strain,
+                          s.lateral_strain,
+                          vol,
+                          s.axial_stress,
+                          s.lateral_stress,
+                          s.load,
+                          s.force,
+                          static_cast<double>(monitor_.tension()),
+                          static_cast<double>(monitor_.shear()),
+                          static_cast<double>(monitor_.total())};
+  const std::vector<double> e = ledger_values(m_.energy());
+  row.insert(row.end(), e.begin(), e.end());
+  history_.push_back(std::move(row));
 }
 
 std::string LoadingFrame::history_csv() const {
+  // Energies count from the start of loading; rows before it (confining, seating) from the start
+  // of the test.
   std::string s = "time_s,step,phase,axial_strain,lateral_strain,volumetric_strain,axial_stress_Pa,"
                   "lateral_stress_Pa,deviator_Pa,force_N,cracks_tension,cracks_shear,"
                   "cracks_total,kinetic_J,strain_J,bond_strain_J,slip_J,local_damping_J,"
-                  "boundary_work_J\n";
+                  "dashpot_J,plastic_J,bond_break_J,body_work_J,boundary_work_J,"
+                  "balance_error_J\n";
+  const EnergyLedger start = energy_start_.size() == EnergyLedger::kTerms
+                                 ? ledger_from(energy_start_.data())
+                                 : EnergyLedger{};
+  const EnergyLedger load =
+      energy_load_.size() == EnergyLedger::kTerms ? ledger_from(energy_load_.data()) : start;
   for (const auto& row : history_) {
-    for (std::size_t k = 0; k < row.size(); ++k) {
+    for (std::size_t k = 0; k < kMeasured; ++k) {
       if (k)
         s += ',';
-      s += (k == 1 || k == 2 || (k >= 10 && k <= 12)) ? std::to_string(std::llround(row[k]))
-                                                      : format_double(row[k]);
+      s += (k == 1 || k == 2 || k >= 10) ? std::to_string(std::llround(row[k]))
+                                         : format_double(row[k]);
     }
+    const EnergyLedger e = ledger_from(row.data() + kMeasured)
+                               .since(row[2] < static_cast<double>(kLoad) ? start : load);
+    for (double v : {e.kinetic(), e.strain, e.bond_strain, e.slip, e.local_damping, e.dashpot,
+                     e.plastic, e.bond_break, e.body_work, e.boundary_work, e.balance_error()})
+      s += ',' + format_double(v);
     s += '\n';
   }
   return s;
@@ -227,6 +280,7 @@ template <class A> void LoadingFrame::fields(A& a) {
   a("servo_integral", servo_integral_), a("bond_break_events", bond_break_events_);
   a("next_snapshot_strain", next_snapshot_strain_), a("snapshot_due", snapshot_due_);
   a("peak_snap_step", peak_snap_step_), a("stop_reason", stop_reason_), a("history", history_);
+  a("energy_start", energy_start_), a("energy_load", energy_load_);
 }
 
 nlohmann::json LoadingFrame::state() const {
@@ -284,6 +338,24 @@ void LoadingFrame::restore(const nlohmann::json& s, const std::string& file) {
   measure(current_);
 }
 
+// The energy ledger of the test, counted from the start of loading, and its balance (warned when
+// it does not close to 1 % of the energy turned over).
+void LoadingFrame::energy_results(nlohmann::json& r) const {
+  const EnergyLedger e = energy_since_loading();
+  nlohmann::json j = energy_json(e);
+  const double scale = e.balance_scale();
+  const double rel = scale > 0 ? e.balance_error() / scale : 0.0;
+  j.erase("initial_total");
+  j["counted_from"] = "the start of loading (step " + std::to_string(load_start_step_) + ")";
+  j["balance_error_relative"] = rel;
+  j["units"] = "J (2D: per metre of thickness)";
+  r["energy_J"] = j;
+  if (!(std::abs(rel) <= 0.01))
+    r["warnings"].push_back("the energy ledger of the loading does not close: balance error " +
+                            format_double(e.balance_error()) + " J, " + format_double(100 * rel) +
+                            " % of the energy turned over");
+}
+
 nlohmann::json LoadingFrame::results() const {
   nlohmann::json r;
   r["units"] = "SI (m, kg, s, N, Pa, J); stresses and strains compression positive";
@@ -310,6 +382,7 @@ nlohmann::json LoadingFrame::results() const {
   r["loading_rate"] = {{"platen_velocity_m_per_s", v_final_},
                        {"strain_rate_per_s", 2 * v_final_ / geo_.loaded_length()}};
   test_.results(*this, r);
+  energy_results(r);
   nlohmann::json spec = {{"dimension", geo_.dim},
                          {"grains", m_.balls.size()},
                          {"height_m", geo_.height0},

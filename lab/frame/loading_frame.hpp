@@ -130,7 +130,9 @@ public:
   const LabSample& current() const { return current_; }
   const PeakRecord& peak() const { return peak_; }
   const nlohmann::json& specimen_meta() const { return meta_; }
-  double load_ref() const { return load_ref_; }       ///< load when loading began [Pa]
+  double load_ref() const { return load_ref_; } ///< load when loading began [Pa]
+  /// The change of every energy term since loading began (since the test began before it) [J].
+  EnergyLedger energy_since_loading() const;
   double sep_ref() const { return sep_ref_; }         ///< separation when loading began [m]
   double separation() const;                          ///< platen or grip separation [m]
   double platen_velocity() const { return v_final_; } ///< while loading [m/s]
@@ -175,6 +177,8 @@ private:
   void drive(double v);
   // loading_frame.cpp
   void record_history();
+  void mark_energy_start();
+  void energy_results(nlohmann::json& r) const;
   void begin_loading();
   void finish(const std::string& why);
   void track_peak();
@@ -213,8 +217,11 @@ private:
   std::int64_t peak_snap_step_ = -1;
   std::string stop_reason_;
   LabSample current_;
-  std::vector<LabSample> samples_; ///< fine record of the loading (fits)
-  std::vector<std::vector<double>> history_;
+  std::vector<LabSample> samples_;           ///< fine record of the loading (fits)
+  std::vector<std::vector<double>> history_; ///< measurements, then the raw energy ledger
+  /// The energy ledger's terms (EnergyLedger::terms) when the test began and when loading began:
+  /// history.csv and results.json count energies from these.
+  std::vector<double> energy_start_, energy_load_;
   CrackMonitor monitor_;
   std::vector<Event> events_;
 };

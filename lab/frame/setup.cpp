@@ -53,6 +53,7 @@ void LoadingFrame::setup() {
   v_final_ =
       p_.platen_velocity > 0 ? p_.platen_velocity : 0.5 * p_.strain_rate * geo_.loaded_length();
   m_.initialize();
+  mark_energy_start();
   phase_ = setup.first_phase;
   phase_start_step_ = m_.step();
   if (phase_ == kLoad)

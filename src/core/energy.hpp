@@ -29,6 +29,24 @@ struct EnergyLedger {
   double balance_error() const {
     return kinetic() + stored() + dissipated() - (initial_total + body_work + boundary_work);
   }
+  /// Every term, in one fixed order (specimen files, checkpoints, history rows).
+  template <class F> void terms(F&& f) {
+    f(kinetic_translational), f(kinetic_rotational), f(strain), f(bond_strain), f(body_work);
+    f(gravity_work), f(boundary_work), f(local_damping), f(slip), f(dashpot), f(plastic);
+    f(bond_break), f(initial_total);
+  }
+  static constexpr int kTerms = 13;
+  /// The change of every term since `ref` (initial_total too, so the change balances on its
+  /// own: its balance_error() is the error accrued since `ref`).
+  EnergyLedger since(EnergyLedger ref) const {
+    double r[kTerms];
+    int i = 0;
+    ref.terms([&](double& x) { r[i++] = x; });
+    EnergyLedger d = *this;
+    i = 0;
+    d.terms([&](double& x) { x -= r[i++]; });
+    return d;
+  }
   /// Scale for a relative balance check.
   double balance_scale() const {
     return initial_total + (body_work < 0 ? -body_work : body_work) +

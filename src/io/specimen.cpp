@@ -114,9 +114,7 @@ template <class A> void io(A& a, SurfaceProps& p) {
   a(p.kn), a(p.ks), a(p.fric), a(p.sj_kn), a(p.sj_ks), a(p.sj_fric);
 }
 template <class A> void io(A& a, EnergyLedger& e) {
-  a(e.kinetic_translational), a(e.kinetic_rotational), a(e.strain), a(e.bond_strain),
-      a(e.body_work), a(e.gravity_work), a(e.boundary_work), a(e.local_damping), a(e.slip),
-      a(e.dashpot), a(e.plastic), a(e.bond_break), a(e.initial_total);
+  e.terms([&](double& x) { a(x); });
 }
 template <class A> void io(A& a, ContactEnergy& e) {
   a(e.strain), a(e.bond_strain), a(e.slip), a(e.dashpot), a(e.plastic);
