@@ -278,7 +278,8 @@ struct SuiteSummary {
   nlohmann::json tests = nlohmann::json::array();
   std::vector<double> s3, s1; ///< confinement and peak stress of UCS and triaxial tests [Pa]
   double ucs = std::nan(""), e = std::nan(""), nu = std::nan(""), bts = std::nan(""),
-         dt = std::nan("");
+         dt = std::nan(""), ci = std::nan("");
+  nlohmann::json warnings = nlohmann::json::array(); ///< every test's, as "NAME: what"
   bool failed = false;
   std::string csv = "name,test,status,confinement_Pa,youngs_modulus_Pa,poisson_ratio,"
                     "peak_stress_Pa,peak_deviator_Pa,tensile_strength_Pa,cracks_tension,"
@@ -313,6 +314,11 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
                           "peak_deviator_Pa", "tensile_strength_Pa"})
     row[key] = or_null(num(r, key));
   row["cracks"] = r["cracks"];
+  if (r.contains("warnings")) {
+    row["warnings"] = r["warnings"];
+    for (const auto& w : r["warnings"])
+      warnings.push_back(t.name + ": " + w.get<std::string>());
+  }
   row["wall_time_s"] = r["provenance"]["wall_time_s"];
   row["grains"] = r["provenance"]["grains"];
   row["steps"] = r["provenance"]["steps"];
@@ -325,6 +331,7 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
     ucs = num(r, "peak_stress_Pa");
     e = num(r, "youngs_modulus_Pa");
     nu = num(r, "poisson_ratio");
+    ci = num(r, "crack_initiation_stress_Pa");
   }
   if (type == "brazilian" && std::isnan(bts))
     bts = num(r, "tensile_strength_Pa");
@@ -351,6 +358,8 @@ nlohmann::json SuiteSummary::properties() const {
       {"bts_Pa", or_null(bts)},
       {"direct_tension_Pa", or_null(dt)},
       {"ucs_over_bts", or_null(ucs / bts)},
+      {"crack_initiation_stress_Pa", or_null(ci)},
+      {"crack_initiation_over_ucs", or_null(ci / ucs)},
       {"direct_tension_over_bts", or_null(dt / bts)},
       {"friction_angle_deg",
        env.has_mc ? or_null(env.friction_angle_deg) : nlohmann::json(nullptr)},
@@ -392,6 +401,7 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
                          {"material_file", s.material_file},
                          {"units", "SI (m, kg, s, N, Pa, J); stresses compression positive"},
                          {"properties", props},
+                         {"warnings", sum.warnings},
                          {"tests", sum.tests},
                          {"parallel_processes", parallel},
                          {"threads_per_process", threads},
@@ -466,6 +476,8 @@ std::string summary_table(const nlohmann::json& sm) {
                 mpa(p["mohr_coulomb_r2"], 1).c_str(), mpa(p["hoek_brown_mi"], 1).c_str(),
                 p["envelope_points"].get<int>());
   t += line;
+  for (const auto& w : sm.value("warnings", nlohmann::json::array()))
+    t += "warning: " + w.get<std::string>() + "\n";
   return t;
 }
 

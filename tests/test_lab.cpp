@@ -361,6 +361,19 @@ TEST(Lab, SuiteRunsTestsInParallelAndSummarises) {
                              p["ucs_Pa"].get<double>() / p["bts_Pa"].get<double>(), 1e-12));
   EXPECT_TRUE(p["friction_angle_deg"].is_number()) << p.dump(); // two confinements: MC fit
   EXPECT_TRUE(p["hoek_brown_mi"].is_null());                    // ... but no Hoek-Brown
+  // The UCS test's crack initiation, and every test's warnings gathered under its name.
+  const nlohmann::json ucs = read_json_file((out / "tests" / "ucs" / "results.json").string());
+  ASSERT_TRUE(ucs["crack_initiation_stress_Pa"].is_number()) << ucs.dump();
+  EXPECT_TRUE(test::near_rel(p["crack_initiation_over_ucs"].get<double>(),
+                             ucs["crack_initiation_stress_Pa"].get<double>() /
+                                 ucs["peak_stress_Pa"].get<double>(),
+                             1e-12));
+  std::size_t n_warnings = 0;
+  for (const auto& row : sm["tests"])
+    n_warnings += row.value("warnings", nlohmann::json::array()).size();
+  EXPECT_EQ(sm["warnings"].size(), n_warnings);
+  for (const auto& w : sm["warnings"])
+    EXPECT_NE(msg.find("warning: " + w.get<std::string>()), std::string::npos) << msg;
   for (const char* t : {"ucs", "tri", "bz"})
     EXPECT_TRUE(fs::exists(out / "tests" / t / "results.json")) << t;
   // The UCS and the triaxial test shared one specimen (genesis once).
