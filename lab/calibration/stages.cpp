@@ -1,0 +1,256 @@
+#include "lab/calibration/stages.hpp"
+
+#include <nlopt.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rocklab::calibration {
+
+double Target::error(double measured) const {
+  if (!std::isfinite(measured))
+    return std::numeric_limits<double>::infinity();
+  return absolute ? (measured - value) / tolerance : (measured / value - 1) / tolerance;
+}
+
+const char* stage_name(Stage s) {
+  switch (s) {
+  case Stage::Elastic:
+    return "elastic";
+  case Stage::Strength:
+    return "strength";
+  case Stage::Ratios:
+    return "ratios";
+  case Stage::Final:
+    return "final";
+  }
+  return "?";
+}
+
+const char* role_name(Role r) {
+  switch (r) {
+  case Role::Modulus:
+    return "modulus";
+  case Role::StiffnessRatio:
+    return "stiffness_ratio";
+  case Role::Strength:
+    return "strength";
+  case Role::Shape:
+    return "shape";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool is_stress(const std::string& property) {
+  return property.size() > 3 && property.ends_with("_Pa") && property != kYoungs;
+}
+
+double value_of(const Measured& m, const std::string& key) {
+  const auto it = m.find(key);
+  return it == m.end() ? std::nan("") : it->second;
+}
+
+struct Campaign {
+  std::vector<Param>& p;
+  const std::vector<Target>& targets;
+  const Evaluate& evaluate;
+  Outcome& out;
+  int since_full = 0; ///< evaluations since the last one that measured everything
+
+  const Target* target(const char* name) const {
+    for (const Target& t : targets)
+      if (t.property == name)
+        return &t;
+    return nullptr;
+  }
+  bool has(Role r) const {
+    return std::any_of(p.begin(), p.end(), [&](const Param& x) { return x.role == r; });
+  }
+  Measured run(Stage s) {
+    std::vector<double> v;
+    for (const Param& x : p)
+      v.push_back(x.value);
+    Measured m = evaluate(v, s);
+    out.history.push_back({static_cast<int>(out.history.size()) + 1, s, v, m});
+    out.measured = m;
+    since_full = (s == Stage::Ratios || s == Stage::Final) ? 0 : since_full + 1;
+    return m;
+  }
+  /// Multiplies every parameter of a role by f, within its bounds.
+  void scale(Role r, double f) {
+    for (Param& x : p)
+      if (x.role == r)
+        x.value = std::clamp(x.value * f, x.lo, x.hi);
+  }
+  bool met(const Target* t, const Measured& m) const {
+    return !t || std::abs(t->error(value_of(m, t->property))) <= 1;
+  }
+
+  void elastic(int budget);
+  void strength(int budget);
+  void ratios(int budget);
+};
+
+// Stage 1. E: the moduli times target/measured. nu: a secant search on log(stiffness ratio),
+// nu rising with the ratio (0.15 per e-fold until two points give the slope), steps at most a
+// factor 2.
+void Campaign::elastic(int budget) {
+  const Target* tE = target(kYoungs);
+  const Target* tn = target(kPoisson);
+  const bool steer_e = tE && has(Role::Modulus), steer_n = tn && has(Role::StiffnessRatio);
+  if (!steer_e && !steer_n)
+    return;
+  double prev_k = std::nan(""), prev_n = std::nan("");
+  for (int i = 0; i < budget; ++i) {
+    const Measured m = run(Stage::Elastic);
+    const bool ok_e = !steer_e || met(tE, m), ok_n = !steer_n || met(tn, m);
+    if (ok_e && ok_n)
+      return;
+    if (steer_n && !ok_n) {
+      const auto k = std::find_if(p.begin(), p.end(),
+                                  [](const Param& x) { return x.role == Role::StiffnessRatio; });
+      const double nu = value_of(m, kPoisson), lk = std::log(k->value);
+      double slope = 0.15;
+      if (std::isfinite(prev_n) && lk != prev_k && nu != prev_n)
+        slope = (nu - prev_n) / (lk - prev_k);
+      if (!(slope > 0.01))
+        slope = 0.15; // noise or a flat stretch: keep the default direction
+      const double step = std::clamp((tn->value - nu) / slope, -std::log(2.0), std::log(2.0));
+      prev_k = lk;
+      prev_n = nu;
+      scale(Role::StiffnessRatio, std::exp(step));
+    }
+    const double e = value_of(m, kYoungs);
+    if (steer_e && e > 0)
+      scale(Role::Modulus, std::clamp(tE->value / e, 0.25, 4.0));
+  }
+}
+
+// Stage 2: all strengths times target UCS / measured UCS.
+void Campaign::strength(int budget) {
+  const Target* tu = target(kUcs);
+  if (!tu || !has(Role::Strength))
+    return;
+  for (int i = 0; i < budget; ++i) {
+    const Measured m = run(Stage::Strength);
+    const double u = value_of(m, kUcs);
+    if (met(tu, m) || !(u > 0))
+      return;
+    scale(Role::Strength, std::clamp(tu->value / u, 0.25, 4.0));
+  }
+}
+
+// Stage 3: the scale-free targets (every target but E and the UCS; a stress target X becomes
+// X / UCS against its target / the UCS target) by BOBYQA over the shape parameters, in [0, 1]
+// coordinates (logarithmic for positive bounds). The best evaluated point is kept, never a model
+// prediction; the search stops early once every scale-free target is met.
+void Campaign::ratios(int budget) {
+  std::vector<std::size_t> shape;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p[i].role == Role::Shape)
+      shape.push_back(i);
+  const Target* tu = target(kUcs);
+  std::vector<const Target*> free;
+  for (const Target& t : targets)
+    if (t.property != kYoungs && t.property != kUcs && (!is_stress(t.property) || tu))
+      free.push_back(&t);
+  if (shape.empty() || free.empty() || budget < 1)
+    return;
+  auto to_x = [&](const Param& q) {
+    return q.lo > 0 ? std::log(q.value / q.lo) / std::log(q.hi / q.lo)
+                    : (q.value - q.lo) / (q.hi - q.lo);
+  };
+  auto from_x = [&](const Param& q, double x) {
+    x = std::clamp(x, 0.0, 1.0);
+    return q.lo > 0 ? q.lo * std::pow(q.hi / q.lo, x) : q.lo + x * (q.hi - q.lo);
+  };
+  auto misfit = [&](const Measured& m, double& worst) {
+    double sum = 0;
+    worst = 0;
+    const double u = value_of(m, kUcs);
+    for (const Target* t : free) {
+      double e;
+      if (is_stress(t->property)) {
+        Target r = *t;
+        r.value = t->value / tu->value;
+        e = r.error(value_of(m, t->property) / u);
+      } else {
+        e = t->error(value_of(m, t->property));
+      }
+      sum += std::isfinite(e) ? e * e : 1e6;
+      worst = std::max(worst, std::abs(e));
+    }
+    return sum;
+  };
+  double best = kInf;
+  std::vector<double> best_values;
+  int used = 0;
+  const std::size_t n = shape.size();
+  nlopt::opt opt(n == 1 ? nlopt::LN_COBYLA : nlopt::LN_BOBYQA, static_cast<unsigned>(n));
+  opt.set_lower_bounds(std::vector<double>(n, 0.0));
+  opt.set_upper_bounds(std::vector<double>(n, 1.0));
+  opt.set_maxeval(budget);
+  opt.set_initial_step(0.15);
+  opt.set_xtol_abs(1e-3);
+  auto objective = [&](const std::vector<double>& x) {
+    for (std::size_t k = 0; k < n; ++k)
+      p[shape[k]].value = from_x(p[shape[k]], x[k]);
+    const Measured m = run(Stage::Ratios);
+    ++used;
+    double worst;
+    const double f = misfit(m, worst);
+    if (f < best) {
+      best = f;
+      best_values.clear();
+      for (const Param& q : p)
+        best_values.push_back(q.value);
+    }
+    if (worst <= 1 || used >= budget)
+      opt.force_stop();
+    return f;
+  };
+  using Fn = decltype(objective);
+  opt.set_min_objective([](const std::vector<double>& x, std::vector<double>&,
+                           void* data) { return (*static_cast<Fn*>(data))(x); },
+                        &objective);
+  std::vector<double> x(n);
+  for (std::size_t k = 0; k < n; ++k)
+    x[k] = to_x(p[shape[k]]);
+  double f = 0;
+  try {
+    opt.optimize(x, f);
+  } catch (const nlopt::forced_stop&) {
+  } catch (const std::exception&) {
+    // roundoff-limited or similar: the best point so far stands
+  }
+  for (std::size_t i = 0; i < p.size() && best_values.size() == p.size(); ++i)
+    p[i].value = best_values[i];
+}
+
+} // namespace
+
+Outcome calibrate(std::vector<Param> params, const std::vector<Target>& targets,
+                  const Evaluate& evaluate, const Budget& budget) {
+  Outcome out;
+  Campaign c{params, targets, evaluate, out};
+  c.elastic(budget.elastic);
+  c.strength(budget.strength);
+  c.ratios(budget.ratios);
+  // The ratios moved the strengths and moduli a little: scale them back, then measure everything.
+  c.elastic(budget.polish);
+  c.strength(budget.polish);
+  if (c.since_full > 0 || out.history.empty())
+    c.run(Stage::Final);
+  out.params = params;
+  out.met = std::all_of(targets.begin(), targets.end(), [&](const Target& t) {
+    return std::abs(t.error(value_of(out.measured, t.property))) <= 1;
+  });
+  return out;
+}
+
+} // namespace rocklab::calibration

@@ -1,0 +1,84 @@
+// The calibration method (docs/calibration.md): three stages that each move the parameters a
+// property depends on most, so that few (expensive, noisy) evaluations are needed.
+//   1 elastic: the moduli scale E (E is proportional to them at a fixed stiffness ratio), the
+//     stiffness ratio sets nu (a secant search, monotonic);
+//   2 strength scale: at fixed strength ratios all strengths scale together, so one factor,
+//     target UCS / measured UCS, iterated to the tolerance;
+//   3 ratios: the dimensionless targets (UCS/BTS, crack initiation/UCS, friction angle, ...) by a
+//     derivative-free optimiser over the shape parameters (NLopt's BOBYQA), then stage 2 again.
+// An evaluation is a callback (the caller runs tests, averages replicate seeds, caches). Units of
+// the properties: SI; the parameters are the card's own.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace rocklab::calibration {
+
+/// What a free parameter does, which decides its stage.
+enum class Role {
+  Modulus,        ///< scales every elastic modulus (several may share the role: moved together)
+  StiffnessRatio, ///< sets Poisson's ratio
+  Strength,       ///< scales every strength (several share the role: moved together)
+  Shape,          ///< a ratio or fraction searched in stage 3
+};
+
+struct Param {
+  std::string name;
+  Role role = Role::Shape;
+  double lo = 0, hi = 0; ///< bounds, lo < hi
+  double value = 0;      ///< start, then the current value
+};
+
+/// A target: a measured property and its tolerance (relative, or absolute when `absolute`).
+struct Target {
+  std::string property; ///< e.g. "youngs_modulus_Pa", "poisson_ratio", "ucs_Pa", "ucs_over_bts"
+  double value = 0;
+  double tolerance = 0.05;
+  bool absolute = false;
+  double error(double measured) const; ///< signed error in tolerances (|e| <= 1: met)
+};
+
+/// The property names each stage steers; any other target is reported, not steered.
+inline const char* const kYoungs = "youngs_modulus_Pa";
+inline const char* const kPoisson = "poisson_ratio";
+inline const char* const kUcs = "ucs_Pa";
+
+/// Elastic and Strength need the tests that measure E, nu (short elastic loading) and the UCS;
+/// Ratios and Final need every test a target names.
+enum class Stage { Elastic, Strength, Ratios, Final };
+
+using Measured = std::map<std::string, double>;
+/// Runs the tests a stage needs for these parameter values (in the order of the Param list).
+using Evaluate = std::function<Measured(const std::vector<double>& values, Stage stage)>;
+
+struct Record {
+  int evaluation = 0;
+  Stage stage = Stage::Elastic;
+  std::vector<double> values;
+  Measured measured;
+};
+
+struct Outcome {
+  std::vector<Param> params; ///< final values
+  Measured measured;         ///< at the final values (the last full evaluation)
+  std::vector<Record> history;
+  bool met = false; ///< every target within its tolerance
+};
+
+/// Evaluations per stage at most; polish: each of stages 1 and 2 again after stage 3. The
+/// defaults add up to at most 36 with the final evaluation.
+struct Budget {
+  int elastic = 6, strength = 4, ratios = 20, polish = 2;
+};
+
+Outcome calibrate(std::vector<Param> params, const std::vector<Target>& targets,
+                  const Evaluate& evaluate, const Budget& budget);
+
+/// Name of a stage or role (reports, errors).
+const char* stage_name(Stage s);
+const char* role_name(Role r);
+
+} // namespace rocklab::calibration
