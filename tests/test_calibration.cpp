@@ -96,3 +96,118 @@ TEST(Calibration, ErrorsAreInTolerancesAndBoundsHold) {
   EXPECT_FALSE(out.met);
   EXPECT_DOUBLE_EQ(out.params[0].value, 2e9);
 }
+
+// ---------------------------------------------------------------------------------------------
+// The calibration file: a good one loads and maps parameters onto the card; bad ones name the key.
+
+#include "helpers.hpp"
+#include "io/input_error.hpp"
+#include "lab/calibration/calibration_file.hpp"
+
+#include <filesystem>
+#include <fstream>
+
+namespace {
+
+nlohmann::json good_calibration() {
+  return {{"name", "ldb-2d"},
+          {"units", "SI"},
+          {"material", rocklab::test::source_dir() + "/materials/granite_fj_2d.json"},
+          {"targets",
+           {{"youngs_modulus_Pa", {{"value", 69e9}, {"tolerance", 0.03}}},
+            {"poisson_ratio", {{"value", 0.26}, {"tolerance", 0.03}, {"absolute", true}}},
+            {"ucs_Pa", {{"value", 200e6}, {"tolerance", 0.05}}},
+            {"ucs_over_bts", {{"value", 21.5}, {"tolerance", 0.1}}}}},
+          {"parameters",
+           {{"flatjoint.fj_emod", {{"role", "modulus"}, {"bounds", {1e10, 1e12}}}},
+            {"linear.emod", {{"role", "modulus"}, {"bounds", {1e10, 1e12}}}},
+            {"flatjoint.fj_kratio", {{"role", "stiffness_ratio"}, {"bounds", {1.0, 5.0}}}},
+            {"flatjoint.fj_ten", {{"role", "strength"}, {"bounds", {1e6, 1e9}}}},
+            {"flatjoint.fj_coh/flatjoint.fj_ten", {{"role", "shape"}, {"bounds", {1.0, 30.0}}}}}},
+          {"tests",
+           {{{"name", "ucs"}, {"test", "ucs"}},
+            {{"name", "bz"},
+             {"test", "brazilian"},
+             {"shape", {{"shape", "disk"}, {"diameter", 0.025}}}}}},
+          {"seeds", {1, 2, 3}}};
+}
+
+std::string write_calibration(const std::string& name, const nlohmann::json& j) {
+  const std::filesystem::path p = rocklab::test::scratch_root() / (name + ".json");
+  std::ofstream(p) << j.dump(2);
+  return p.string();
+}
+
+std::string error_of(const nlohmann::json& j) {
+  try {
+    load_calibration(write_calibration("bad", j));
+  } catch (const rocklab::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+} // namespace
+
+TEST(CalibrationFile, ReadsTheFileAndSetsTheCard) {
+  const CalibrationFile c = load_calibration(write_calibration("good", good_calibration()));
+  ASSERT_EQ(c.params.size(), 5u);
+  ASSERT_EQ(c.targets.size(), 4u);
+  EXPECT_EQ(c.seeds.size(), 3u);
+  // Parameters in key order; starts are the card's values: fj_ten mean 3.5e7, fj_coh/fj_ten
+  // 3.5e8/3.5e7 = 10.
+  auto find = [&](const std::string& key) {
+    return std::find_if(c.params.begin(), c.params.end(),
+                        [&](const CardParam& p) { return p.key == key; });
+  };
+  const auto ratio = find("flatjoint.fj_coh/flatjoint.fj_ten");
+  ASSERT_NE(ratio, c.params.end());
+  EXPECT_EQ(ratio->path, "flatjoint.fj_coh");
+  EXPECT_EQ(ratio->over, "flatjoint.fj_ten");
+  EXPECT_DOUBLE_EQ(ratio->param.value, 10.0);
+  EXPECT_EQ(ratio->param.role, Role::Shape);
+  std::vector<double> v;
+  for (const CardParam& p : c.params)
+    v.push_back(p.key == "flatjoint.fj_ten" ? 7e7 : p.param.value);
+  v[static_cast<std::size_t>(ratio - c.params.begin())] = 5.0;
+  const nlohmann::json card = apply_params(c.material, c.params, v);
+  // The strength keeps its coefficient of variation (sd 7e6 of 3.5e7 -> 1.4e7 of 7e7), and the
+  // ratio applies to the new tension: cohesion 5 x 7e7.
+  EXPECT_DOUBLE_EQ(card["flatjoint"]["fj_ten"]["mean"].get<double>(), 7e7);
+  EXPECT_NEAR(card["flatjoint"]["fj_ten"]["sd"].get<double>(), 1.4e7, 1e-3);
+  EXPECT_DOUBLE_EQ(card["flatjoint"]["fj_coh"]["mean"].get<double>(), 3.5e8);
+  EXPECT_NEAR(card["flatjoint"]["fj_coh"]["sd"].get<double>(), 7e7, 1e-3);
+  EXPECT_DOUBLE_EQ(card["linear"]["emod"].get<double>(), 1e11);
+}
+
+TEST(CalibrationFile, BadFilesNameTheKeyAndWhatIsAllowed) {
+  nlohmann::json j = good_calibration();
+  j["parameters"]["flatjoint.fj_nope"] = {{"role", "strength"}, {"bounds", {1, 2}}};
+  EXPECT_NE(error_of(j).find("no number or {\"mean\", \"sd\"} at \"flatjoint.fj_nope\""),
+            std::string::npos)
+      << error_of(j);
+  j = good_calibration();
+  j["parameters"]["flatjoint.fj_ten"]["bounds"] = {5e7, 5e7};
+  EXPECT_NE(error_of(j).find("empty bounds"), std::string::npos) << error_of(j);
+  j = good_calibration();
+  j["parameters"]["flatjoint.fj_ten"]["bounds"] = {1e8, 1e9};
+  EXPECT_NE(error_of(j).find("outside the bounds"), std::string::npos) << error_of(j);
+  j = good_calibration();
+  j["targets"]["direct_tension_Pa"] = {{"value", 6.9e6}, {"tolerance", 0.08}};
+  EXPECT_NE(error_of(j).find("needs 1 \"direct_tension\" test"), std::string::npos) << error_of(j);
+  j = good_calibration();
+  j["targets"]["ucs_mpa"] = {{"value", 200}};
+  EXPECT_NE(error_of(j).find("unknown target; allowed: youngs_modulus_Pa"), std::string::npos)
+      << error_of(j);
+  j = good_calibration();
+  j["parameters"]["flatjoint.fj_ten"]["role"] = "strenght";
+  EXPECT_NE(error_of(j).find("strenght"), std::string::npos) << error_of(j);
+  j = good_calibration();
+  j["parameters"].erase("flatjoint.fj_ten");
+  EXPECT_NE(error_of(j).find("denominator \"flatjoint.fj_ten\" must be a free parameter"),
+            std::string::npos)
+      << error_of(j);
+  j = good_calibration();
+  j["budgte"] = 3;
+  EXPECT_NE(error_of(j).find("budgte"), std::string::npos) << error_of(j);
+}

@@ -1,0 +1,228 @@
+#include "lab/calibration/calibration_file.hpp"
+
+#include "io/input_error.hpp"
+#include "io/json_input.hpp"
+#include "io/results.hpp"
+#include "materials/material_card.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+namespace fs = std::filesystem;
+
+namespace rocklab::calibration {
+
+const std::vector<TargetNeed>& target_needs() {
+  static const std::vector<TargetNeed> needs{
+      {kYoungs, "ucs", 1, nullptr},
+      {kPoisson, "ucs", 1, nullptr},
+      {kUcs, "ucs", 1, nullptr},
+      {"crack_initiation_over_ucs", "ucs", 1, nullptr},
+      {"bts_Pa", "brazilian", 1, nullptr},
+      {"direct_tension_Pa", "direct_tension", 1, nullptr},
+      {"ucs_over_bts", "ucs", 1, "brazilian"},
+      {"direct_tension_over_bts", "direct_tension", 1, "brazilian"},
+      {"friction_angle_deg", "triaxial", 1, "ucs"},
+      {"cohesion_Pa", "triaxial", 1, "ucs"},
+      {"hoek_brown_mi", "triaxial", 2, "ucs"}};
+  return needs;
+}
+
+namespace {
+
+// The card value at "section.key": a number, or the mean of a {"mean", "sd"} distribution.
+const nlohmann::json* card_value(const nlohmann::json& card, const std::string& path) {
+  const nlohmann::json* v = &card;
+  std::size_t a = 0;
+  while (a <= path.size()) {
+    const std::size_t b = std::min(path.find('.', a), path.size());
+    const std::string part = path.substr(a, b - a);
+    if (!v->is_object() || !v->contains(part))
+      return nullptr;
+    v = &(*v)[part];
+    a = b + 1;
+  }
+  return v;
+}
+
+double number_of(const nlohmann::json& v) {
+  if (v.is_number())
+    return v.get<double>();
+  if (v.is_object() && v.contains("mean") && v["mean"].is_number())
+    return v["mean"].get<double>();
+  return std::nan("");
+}
+
+Role role_of(JsonObject& o) {
+  const std::string r = o.choice("role", {"modulus", "stiffness_ratio", "strength", "shape"});
+  return r == "modulus"           ? Role::Modulus
+         : r == "stiffness_ratio" ? Role::StiffnessRatio
+         : r == "strength"        ? Role::Strength
+                                  : Role::Shape;
+}
+
+CardParam read_param(const CalibrationFile& c, JsonObject& top, const std::string& key) {
+  JsonObject o = top.object(key);
+  CardParam p;
+  p.key = key;
+  const std::size_t slash = key.find('/');
+  p.path = key.substr(0, slash);
+  p.over = slash == std::string::npos ? "" : key.substr(slash + 1);
+  p.param.name = key;
+  p.param.role = role_of(o);
+  const auto bounds = o.array("bounds");
+  if (bounds.size() != 2 || !bounds[0].first->is_number() || !bounds[1].first->is_number())
+    top.fail(key, "\"bounds\" must be [low, high], two numbers");
+  p.param.lo = bounds[0].first->get<double>();
+  p.param.hi = bounds[1].first->get<double>();
+  if (!(p.param.lo < p.param.hi))
+    top.fail(key, "empty bounds [" + format_double(p.param.lo) + ", " + format_double(p.param.hi) +
+                      "]: low must be below high");
+  o.finish();
+  double start = std::nan("");
+  for (const std::string& path : {p.path, p.over}) {
+    if (path.empty())
+      continue;
+    const nlohmann::json* v = card_value(c.material, path);
+    if (!v || !std::isfinite(number_of(*v)))
+      top.fail(key, "the card " + c.material_file + " has no number or {\"mean\", \"sd\"} at \"" +
+                        path + "\" (write \"section.key\", e.g. \"flatjoint.fj_ten\")");
+  }
+  start = number_of(*card_value(c.material, p.path));
+  if (!p.over.empty())
+    start /= number_of(*card_value(c.material, p.over));
+  if (!(start >= p.param.lo && start <= p.param.hi))
+    top.fail(key, "the card's value " + format_double(start) + " lies outside the bounds [" +
+                      format_double(p.param.lo) + ", " + format_double(p.param.hi) + "]");
+  p.param.value = start;
+  return p;
+}
+
+void read_targets(CalibrationFile& c, JsonObject& top) {
+  JsonObject t = top.object("targets");
+  std::vector<std::string> known;
+  for (const TargetNeed& n : target_needs())
+    known.push_back(n.property);
+  for (const auto& [name, v] : top.raw("targets").items()) {
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      std::string list;
+      for (const std::string& k : known)
+        list += (list.empty() ? "" : ", ") + k;
+      t.fail(name, "unknown target; allowed: " + list);
+    }
+    JsonObject o = t.object(name);
+    Target g;
+    g.property = name;
+    g.value = o.number("value", Range::any());
+    g.absolute = o.boolean("absolute", false);
+    g.tolerance = o.number("tolerance", g.absolute ? Range::positive() : Range::closed(1e-4, 1));
+    if (!g.absolute && g.value == 0)
+      o.fail("value", "a relative tolerance needs a non-zero target (or \"absolute\": true)");
+    o.finish();
+    c.targets.push_back(g);
+  }
+  if (c.targets.empty())
+    top.fail("targets", "no target given");
+}
+
+// Every target must be measured by the listed tests.
+void check_coverage(const CalibrationFile& c, JsonObject& top) {
+  std::map<std::string, int> have;
+  for (const auto& t : c.tests)
+    if (t.is_object() && t.contains("test") && t["test"].is_string())
+      ++have[t["test"].get<std::string>()];
+  for (const Target& t : c.targets)
+    for (const TargetNeed& n : target_needs()) {
+      if (t.property != n.property)
+        continue;
+      if (have[n.test] < n.count || (n.other && have[n.other] < 1))
+        top.fail("targets", "target \"" + t.property + "\" needs " + std::to_string(n.count) +
+                                " \"" + n.test + "\" test(s)" +
+                                (n.other ? std::string(" and a \"") + n.other + "\" test" : "") +
+                                " in \"tests\"");
+    }
+}
+
+} // namespace
+
+CalibrationFile load_calibration(const std::string& path) {
+  CalibrationFile c;
+  c.file = path;
+  const nlohmann::json j = read_json_file(path);
+  JsonObject top(j, path, "");
+  if (top.has("units") && top.string("units") != "SI")
+    top.fail("units", "only \"SI\" is supported");
+  c.name = top.string("name", fs::path(path).stem().string());
+  top.string("description", "");
+  top.string("source", "");
+  const std::string m = top.string("material");
+  c.material_file = fs::path(m).is_absolute()
+                        ? m
+                        : (fs::path(path).parent_path() / m).lexically_normal().string();
+  if (!fs::exists(c.material_file))
+    top.fail("material", "\"" + c.material_file + "\" does not exist");
+  load_material_card(c.material_file); // the base card must be valid on its own
+  c.material = read_json_file(c.material_file);
+  read_targets(c, top);
+  JsonObject params = top.object("parameters");
+  for (const auto& [key, v] : top.raw("parameters").items())
+    c.params.push_back(read_param(c, params, key));
+  if (c.params.empty())
+    top.fail("parameters", "no free parameter given");
+  for (const CardParam& p : c.params)
+    if (!p.over.empty() && std::none_of(c.params.begin(), c.params.end(), [&](const CardParam& q) {
+          return q.over.empty() && q.path == p.over;
+        }))
+      params.fail(p.key, "a ratio's denominator \"" + p.over + "\" must be a free parameter too");
+  for (const auto& [t, tpath] : top.array("tests"))
+    c.tests.push_back(*t);
+  check_coverage(c, top);
+  for (const auto& [s, spath] : top.array("seeds", false)) {
+    if (!s->is_number_integer() || s->get<std::int64_t>() < 0)
+      throw InputError(path + ": key '" + spath + "': a seed must be a non-negative integer");
+    c.seeds.push_back(s->get<std::uint64_t>());
+  }
+  if (c.seeds.empty())
+    c.seeds = {1, 2, 3};
+  JsonObject b = top.optional_object("budget");
+  c.budget.elastic = static_cast<int>(b.integer("elastic", 0, 100, c.budget.elastic));
+  c.budget.strength = static_cast<int>(b.integer("strength", 0, 100, c.budget.strength));
+  c.budget.ratios = static_cast<int>(b.integer("ratios", 0, 1000, c.budget.ratios));
+  c.budget.polish = static_cast<int>(b.integer("polish", 0, 100, c.budget.polish));
+  b.finish();
+  top.finish();
+  return c;
+}
+
+nlohmann::json apply_params(const nlohmann::json& card, const std::vector<CardParam>& params,
+                            const std::vector<double>& values) {
+  nlohmann::json out = card;
+  auto set = [&](const std::string& path, double v) {
+    nlohmann::json* x = &out;
+    std::size_t a = 0;
+    while (a <= path.size()) {
+      const std::size_t b = std::min(path.find('.', a), path.size());
+      x = &(*x)[path.substr(a, b - a)];
+      a = b + 1;
+    }
+    if (x->is_object()) { // a distribution keeps its coefficient of variation
+      const double mean = (*x)["mean"].get<double>();
+      if (x->contains("sd") && mean != 0)
+        (*x)["sd"] = (*x)["sd"].get<double>() * v / mean;
+      (*x)["mean"] = v;
+    } else {
+      *x = v;
+    }
+  };
+  for (int pass = 0; pass < 2; ++pass) // plain values first, then ratios over them
+    for (std::size_t i = 0; i < params.size(); ++i) {
+      const CardParam& p = params[i];
+      if (p.over.empty() != (pass == 0))
+        continue;
+      set(p.path, pass == 0 ? values[i] : values[i] * number_of(*card_value(out, p.over)));
+    }
+  return out;
+}
+
+} // namespace rocklab::calibration
