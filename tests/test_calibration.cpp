@@ -1,14 +1,25 @@
-// The calibration stages on a cheap synthetic rock with a known answer: every parameter starts 2x
-// off, the measurements carry 0.5 % noise, and the targets must be met within the acceptance
-// tolerances in at most 40 evaluations.
+// Calibration: the stages on a cheap synthetic rock with a known answer (every parameter 2x off,
+// 0.5 % noise, the acceptance tolerances in at most 40 evaluations); the calibration file, good and
+// bad; rocklab calibrate end to end on a tiny specimen, interrupted and resumed from its cache.
 #include "lab/calibration/stages.hpp"
 
-#include <gtest/gtest.h>
+#include "helpers.hpp"
+#include "io/input_error.hpp"
+#include "lab/calibration/calibration_file.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <gtest/gtest.h>
 #include <random>
+#include <regex>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
 
 using namespace rocklab::calibration;
 
@@ -99,13 +110,6 @@ TEST(Calibration, ErrorsAreInTolerancesAndBoundsHold) {
 
 // ---------------------------------------------------------------------------------------------
 // The calibration file: a good one loads and maps parameters onto the card; bad ones name the key.
-
-#include "helpers.hpp"
-#include "io/input_error.hpp"
-#include "lab/calibration/calibration_file.hpp"
-
-#include <filesystem>
-#include <fstream>
 
 namespace {
 
@@ -210,4 +214,84 @@ TEST(CalibrationFile, BadFilesNameTheKeyAndWhatIsAllowed) {
   j = good_calibration();
   j["budgte"] = 3;
   EXPECT_NE(error_of(j).find("budgte"), std::string::npos) << error_of(j);
+}
+
+// ---------------------------------------------------------------------------------------------
+// rocklab calibrate end to end on a tiny 2D specimen: E and UCS from a card 2-4x off; a run
+// interrupted after its first evaluation resumes from the cache; a rerun runs nothing.
+
+TEST(CalibrationCli, TinyCalibrationMeetsItsTargetsAndResumesFromItsCache) {
+  namespace fs = std::filesystem;
+  const fs::path dir = rocklab::test::scratch_root() / "calibrate";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const nlohmann::json j{
+      {"name", "tiny"},
+      {"units", "SI"},
+      {"material", rocklab::test::source_dir() + "/tests/data/lab_2d_fj.json"},
+      {"targets",
+       {{"youngs_modulus_Pa", {{"value", 3e9}, {"tolerance", 0.05}}},
+        {"ucs_Pa", {{"value", 20e6}, {"tolerance", 0.05}}}}},
+      {"parameters",
+       {{"flatjoint.fj_emod", {{"role", "modulus"}, {"bounds", {1e8, 1e12}}}},
+        {"flatjoint.fj_ten", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}},
+        {"flatjoint.fj_coh", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}}}},
+      {"tests",
+       {{{"name", "ucs"}, {"test", "ucs"}, {"output", {{"vtk", false}, {"plots", false}}}}}},
+      {"seeds", {1}},
+      {"budget", {{"elastic", 4}, {"strength", 4}, {"ratios", 0}, {"polish", 1}}}};
+  const std::string file = (dir / "tiny.json").string(), out = (dir / "out").string();
+  std::ofstream(file) << j.dump(2);
+  // Interrupt once the first evaluation is in the cache.
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl(rocklab::test::binary().c_str(), "rocklab", "calibrate", file.c_str(), "-o", out.c_str(),
+          "-q", "--jobs", "1", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  auto evaluations = [&] {
+    int n = 0;
+    if (fs::exists(dir / "out" / "evaluations"))
+      for (const auto& e : fs::directory_iterator(dir / "out" / "evaluations"))
+        n += fs::exists(e.path() / "suite" / "summary.json") ? 1 : 0;
+    return n;
+  };
+  for (int i = 0; i < 6000 && evaluations() == 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  ASSERT_EQ(WEXITSTATUS(status), 130) << "the calibration finished before it was interrupted";
+  const int done = evaluations();
+  ASSERT_GE(done, 1);
+  EXPECT_FALSE(fs::exists(dir / "out" / "card.json"));
+  // Resume: the cached evaluations are reused, the targets met.
+  std::string msg;
+  ASSERT_EQ(rocklab::test::run_command(
+                rocklab::test::binary() + " calibrate " + file + " -o " + out + " --jobs 1", &msg),
+            0)
+      << msg;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(msg, m, std::regex(R"(\((\d+) suites run, (\d+) cached\))")))
+      << msg;
+  EXPECT_GE(std::stoi(m[2]), done) << msg;
+  EXPECT_NE(msg.find("every target met"), std::string::npos) << msg;
+  const nlohmann::json card =
+      nlohmann::json::parse(rocklab::test::read_file(dir / "out" / "card.json"));
+  EXPECT_GT(card["flatjoint"]["fj_emod"].get<double>(), 1e9); // moved from the start
+  EXPECT_NE(card["source"].get<std::string>().find("every target met"), std::string::npos);
+  const std::string report = rocklab::test::read_file(dir / "out" / "report.md");
+  EXPECT_NE(report.find("| youngs_modulus_Pa | 3e+09 | 5 % |"), std::string::npos) << report;
+  // The fitted card is a valid material card, and a rerun runs nothing and writes the same card.
+  ASSERT_EQ(rocklab::test::run_command(
+                rocklab::test::binary() + " calibrate " + file + " -o " + out + " --jobs 1", &msg),
+            0)
+      << msg;
+  EXPECT_NE(msg.find("(0 suites run"), std::string::npos) << msg;
+  EXPECT_EQ(nlohmann::json::parse(rocklab::test::read_file(dir / "out" / "card.json")), card);
+  ASSERT_EQ(rocklab::test::run_command(rocklab::test::binary() + " genesis " + out +
+                                       "/card.json -o " + out + "/fitted.rlspec -q"),
+            0);
 }

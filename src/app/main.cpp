@@ -4,6 +4,7 @@
 #include "io/scene.hpp"
 #include "io/scene_run.hpp"
 #include "io/specimen.hpp"
+#include "lab/calibration/campaign.hpp"
 #include "lab/protocol_table.hpp"
 #include "lab/suite.hpp"
 #include "materials/genesis.hpp"
@@ -15,6 +16,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <unistd.h>
 
@@ -157,6 +159,22 @@ int test_command(const std::string& protocol_file, const std::string& out_dir, b
   return 0;
 }
 
+int calibrate_command(const std::string& file, const std::string& out_dir, bool quiet, int jobs) {
+  rocklab::calibration::EvaluatorOptions o;
+  o.out_dir = out_dir;
+  o.executable = std::filesystem::read_symlink("/proc/self/exe").string();
+  o.jobs = jobs;
+  o.interrupt = &g_interrupt;
+  const rocklab::calibration::CampaignSummary cs = rocklab::calibration::run_campaign(file, o);
+  if (!quiet)
+    std::printf("calibration  %s: %zu evaluations (%d suites run, %d cached), %.1f s\n"
+                "wrote        %s/card.json, report.md, convergence.csv\n",
+                cs.outcome.met ? "every target met" : "NOT every target met",
+                cs.outcome.history.size(), cs.suites_run, cs.suites_cached, cs.wall_seconds,
+                out_dir.c_str());
+  return cs.outcome.met ? 0 : 1;
+}
+
 int suite_command(const std::string& suite_file, const std::string& out_dir, bool quiet,
                   int threads) {
   const rocklab::Suite s = rocklab::load_suite(suite_file);
@@ -196,6 +214,22 @@ int info_command() {
 }
 
 } // namespace
+
+// Runs a command; input errors exit with 2, physical blow-ups with 3, an interrupt with 130.
+int guarded(const std::function<int()>& command) {
+  try {
+    return command();
+  } catch (const rocklab::InputError& e) {
+    std::fprintf(stderr, "rocklab: input error: %s\n", e.what());
+    return 2;
+  } catch (const rocklab::PhysicsError& e) {
+    std::fprintf(stderr, "rocklab: %s\n", e.what());
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rocklab: error: %s\n", e.what());
+    return g_interrupt.load() ? 130 : 1;
+  }
+}
 
 int main(int argc, char** argv) {
   CLI::App app{"rocklab - a virtual rock-mechanics laboratory (bonded-particle DEM).\n"
@@ -261,6 +295,18 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   suite->add_flag("-q,--quiet", quiet, "No progress and no summary");
 
+  std::string calib_file, calib_out;
+  int jobs = 0;
+  CLI::App* calib = app.add_subcommand(
+      "calibrate", "Fit a material card's micro-parameters to laboratory targets "
+                   "(docs/calibration.md); writes OUT/card.json, report.md, convergence.csv and "
+                   "keeps every evaluation in OUT/evaluations/ (a rerun reuses them)");
+  calib->add_option("calibration", calib_file, "Calibration file (JSON)")->required();
+  calib->add_option("-o,--out", calib_out, "Output directory")->required();
+  calib->add_option("--jobs", jobs, "Test processes at once (0: one per core)")
+      ->check(CLI::NonNegativeNumber);
+  calib->add_flag("-q,--quiet", quiet, "No summary");
+
   CLI::App* info =
       app.add_subcommand("info", "Print the version, threads, contact models and lab tests");
 
@@ -269,8 +315,7 @@ int main(int argc, char** argv) {
     omp_set_num_threads(threads);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-
-  try {
+  return guarded([&] {
     if (*run)
       return run_command(scene_file, out_dir, quiet);
     if (*gen)
@@ -281,15 +326,8 @@ int main(int argc, char** argv) {
       return test_command(protocol_file, test_out, quiet, checkpoint_every, resume);
     if (*info)
       return info_command();
-  } catch (const rocklab::InputError& e) {
-    std::fprintf(stderr, "rocklab: input error: %s\n", e.what());
-    return 2;
-  } catch (const rocklab::PhysicsError& e) {
-    std::fprintf(stderr, "rocklab: %s\n", e.what());
-    return 3;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "rocklab: error: %s\n", e.what());
-    return g_interrupt.load() ? 130 : 1;
-  }
-  return 0;
+    if (*calib)
+      return calibrate_command(calib_file, calib_out, quiet, jobs);
+    return 0;
+  });
 }

@@ -1,0 +1,43 @@
+// One calibration evaluation: the card for a parameter vector, a suite of the tests a stage needs
+// on every replicate seed, the mean of their properties. Each (card, tests, seed, rocklab version)
+// is cached on disk by its hash, so a killed campaign resumes and reuses what it had. Units SI.
+#pragma once
+
+#include "lab/calibration/calibration_file.hpp"
+
+#include <atomic>
+#include <string>
+
+namespace rocklab::calibration {
+
+struct EvaluatorOptions {
+  std::string out_dir;    ///< evaluations go to OUT_DIR/evaluations/HASH/
+  std::string executable; ///< the rocklab binary that runs each test
+  int jobs = 0;           ///< test processes at once (0: one per core)
+  const std::atomic<bool>* interrupt = nullptr;
+};
+
+/// Properties of one evaluation: the mean over seeds, and their standard deviations under the
+/// same keys with "_sd" appended.
+struct Evaluation {
+  Measured mean, sd;
+  std::vector<std::string> folders; ///< the suites' output folders, one per seed
+  int cached = 0;                   ///< seeds found in the cache
+};
+
+class Evaluator {
+public:
+  Evaluator(const CalibrationFile& c, EvaluatorOptions o) : c_(c), o_(std::move(o)) {}
+  /// The tests of a stage: Elastic and Strength run the UCS tests only, Ratios and Final all.
+  nlohmann::json tests_of(Stage s) const;
+  Evaluation run(const std::vector<double>& values, Stage s);
+  int suites_run() const { return run_; }
+  int suites_cached() const { return cached_; }
+
+private:
+  const CalibrationFile& c_;
+  EvaluatorOptions o_;
+  int run_ = 0, cached_ = 0;
+};
+
+} // namespace rocklab::calibration
