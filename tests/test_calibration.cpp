@@ -295,3 +295,28 @@ TEST(CalibrationCli, TinyCalibrationMeetsItsTargetsAndResumesFromItsCache) {
                                        "/card.json -o " + out + "/fitted.rlspec -q"),
             0);
 }
+
+TEST(CalibrationFile, ShippedTargetsLoadAndBadFilesExitWithTwo) {
+  const std::string shipped = rocklab::test::source_dir() + "/lab/calibrate/lac_du_bonnet_2d.json";
+  const CalibrationFile c = load_calibration(shipped);
+  EXPECT_EQ(c.targets.size(), 7u);
+  EXPECT_EQ(c.params.size(), 7u);
+  std::string msg;
+  EXPECT_EQ(rocklab::test::run_command(rocklab::test::binary() + " calibrate " + shipped + " -o " +
+                                           (rocklab::test::scratch_root() / "chk").string() +
+                                           " --check",
+                                       &msg),
+            0)
+      << msg;
+  EXPECT_NE(msg.find("parameter    flatjoint.fj_coh/flatjoint.fj_ten"), std::string::npos) << msg;
+  nlohmann::json bad = good_calibration();
+  bad["parameters"]["flatjoint.fj_ten"]["bounds"] = {5e7, 5e7};
+  const std::string file = write_calibration("bad_cli", bad);
+  const std::string out = (rocklab::test::scratch_root() / "bad_cli_out").string();
+  EXPECT_EQ(rocklab::test::run_command(
+                rocklab::test::binary() + " calibrate " + file + " -o " + out, &msg),
+            2);
+  EXPECT_NE(msg.find("parameters.flatjoint.fj_ten"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("empty bounds"), std::string::npos) << msg;
+  EXPECT_FALSE(std::filesystem::exists(out)) << "a bad file writes nothing";
+}

@@ -159,6 +159,22 @@ int test_command(const std::string& protocol_file, const std::string& out_dir, b
   return 0;
 }
 
+int calibrate_check(const std::string& file) {
+  namespace cal = rocklab::calibration;
+  const cal::CalibrationFile c = cal::load_calibration(file);
+  std::printf("calibration  %s: base card %s, %zu seed(s) per evaluation\n", c.name.c_str(),
+              c.material_file.c_str(), c.seeds.size());
+  for (const cal::Target& t : c.targets)
+    std::printf("target       %-26s %.4g %s %.4g\n", t.property.c_str(), t.value,
+                t.absolute ? "+-" : "within (relative)", t.tolerance);
+  for (const cal::CardParam& p : c.params)
+    std::printf("parameter    %-36s %-15s start %.4g in [%.4g, %.4g]\n", p.key.c_str(),
+                cal::role_name(p.param.role), p.param.value, p.param.lo, p.param.hi);
+  std::printf("budget       elastic %d, strength %d, ratios %d, polish %d (+1 final)\n",
+              c.budget.elastic, c.budget.strength, c.budget.ratios, c.budget.polish);
+  return 0;
+}
+
 int calibrate_command(const std::string& file, const std::string& out_dir, bool quiet, int jobs) {
   rocklab::calibration::EvaluatorOptions o;
   o.out_dir = out_dir;
@@ -214,6 +230,26 @@ int info_command() {
 }
 
 } // namespace
+
+struct CalibrateArgs {
+  std::string file, out;
+  int jobs = 0;
+  bool check = false;
+};
+
+CLI::App* add_calibrate(CLI::App& app, CalibrateArgs& a, bool& quiet) {
+  CLI::App* c = app.add_subcommand(
+      "calibrate", "Fit a material card's micro-parameters to laboratory targets "
+                   "(docs/calibration.md); writes OUT/card.json, report.md, convergence.csv and "
+                   "keeps every evaluation in OUT/evaluations/ (a rerun reuses them)");
+  c->add_option("calibration", a.file, "Calibration file (JSON)")->required();
+  c->add_option("-o,--out", a.out, "Output directory")->required();
+  c->add_option("--jobs", a.jobs, "Test processes at once (0: one per core)")
+      ->check(CLI::NonNegativeNumber);
+  c->add_flag("-q,--quiet", quiet, "No summary");
+  c->add_flag("--check", a.check, "Check the file and print the plan; run nothing");
+  return c;
+}
 
 // Runs a command; input errors exit with 2, physical blow-ups with 3, an interrupt with 130.
 int guarded(const std::function<int()>& command) {
@@ -295,17 +331,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   suite->add_flag("-q,--quiet", quiet, "No progress and no summary");
 
-  std::string calib_file, calib_out;
-  int jobs = 0;
-  CLI::App* calib = app.add_subcommand(
-      "calibrate", "Fit a material card's micro-parameters to laboratory targets "
-                   "(docs/calibration.md); writes OUT/card.json, report.md, convergence.csv and "
-                   "keeps every evaluation in OUT/evaluations/ (a rerun reuses them)");
-  calib->add_option("calibration", calib_file, "Calibration file (JSON)")->required();
-  calib->add_option("-o,--out", calib_out, "Output directory")->required();
-  calib->add_option("--jobs", jobs, "Test processes at once (0: one per core)")
-      ->check(CLI::NonNegativeNumber);
-  calib->add_flag("-q,--quiet", quiet, "No summary");
+  CalibrateArgs cal;
+  CLI::App* calib = add_calibrate(app, cal, quiet);
 
   CLI::App* info =
       app.add_subcommand("info", "Print the version, threads, contact models and lab tests");
@@ -327,7 +354,8 @@ int main(int argc, char** argv) {
     if (*info)
       return info_command();
     if (*calib)
-      return calibrate_command(calib_file, calib_out, quiet, jobs);
+      return cal.check ? calibrate_check(cal.file)
+                       : calibrate_command(cal.file, cal.out, quiet, cal.jobs);
     return 0;
   });
 }
