@@ -11,7 +11,8 @@
 # (lab/*.json, lab/drops/*.json) - about 30 minutes on 2 cores. full: also the suites
 # (lab/suites/*.json) - about 1.5 hours more. Run from any folder; inputs are read from this
 # checkout. What is left out of a digest: wall-clock times ("wall_time_s", "seconds", the
-# suite's tests.csv time column), the absolute paths of the checkout and of OUTDIR, and logs.
+# suite's tests.csv time column), the absolute paths of the checkout and of OUTDIR, the process id
+# in a suite's staging-folder name, and logs.
 # Digests are comparable between two builds of the same type on the same machine.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -21,6 +22,9 @@ normalize() { # FILE ROOT OUT -> normalized bytes on stdout
 import json, sys
 path, root, out = sys.argv[1], sys.argv[2].encode(), sys.argv[3].encode()
 data = open(path, 'rb').read().replace(out, b'<OUT>').replace(root, b'<ROOT>')
+# a suite's staging folder is named by its process id (.partial-PID); results.json records it
+import re
+data = re.sub(rb'/\.partial-[0-9]+', b'/.partial', data)
 def strip(j):
     if isinstance(j, dict):
         return {k: strip(v) for k, v in j.items() if k not in ('wall_time_s', 'seconds')}
