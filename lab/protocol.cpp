@@ -11,17 +11,12 @@
 
 namespace rocklab {
 
-namespace {
-
-// A path in a protocol is relative to the protocol file's folder.
 std::string resolve(const std::string& file, const std::string& p) {
   const std::filesystem::path path(p);
   if (path.is_absolute())
     return p;
   return (std::filesystem::path(file).parent_path() / path).lexically_normal().string();
 }
-
-} // namespace
 
 Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
                             const std::string& key_path) {

@@ -59,4 +59,7 @@ Protocol load_protocol(const std::string& path);
 Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
                             const std::string& key_path);
 
+/// A path written in an input file, relative to that file's folder (absolute paths stay).
+std::string resolve(const std::string& file, const std::string& p);
+
 } // namespace rocklab

@@ -109,9 +109,7 @@ Suite load_suite(const std::string& path) {
   top.string("description", "");
   {
     const std::string m = top.string("material");
-    const fs::path mp(m);
-    s.material_file =
-        mp.is_absolute() ? m : (fs::path(path).parent_path() / mp).lexically_normal().string();
+    s.material_file = resolve(path, m);
     if (!fs::exists(s.material_file))
       top.fail("material", "\"" + s.material_file + "\" does not exist");
     s.material = read_json_file(s.material_file);

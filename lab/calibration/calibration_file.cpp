@@ -3,6 +3,7 @@
 #include "io/input_error.hpp"
 #include "io/json_input.hpp"
 #include "io/results.hpp"
+#include "lab/protocol.hpp"
 #include "materials/material_card.hpp"
 
 #include <cmath>
@@ -157,9 +158,7 @@ CalibrationFile load_calibration(const std::string& path) {
   top.string("description", "");
   top.string("source", "");
   const std::string m = top.string("material");
-  c.material_file = fs::path(m).is_absolute()
-                        ? m
-                        : (fs::path(path).parent_path() / m).lexically_normal().string();
+  c.material_file = resolve(path, m);
   if (!fs::exists(c.material_file))
     top.fail("material", "\"" + c.material_file + "\" does not exist");
   load_material_card(c.material_file); // the base card must be valid on its own
