@@ -51,9 +51,13 @@ void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
     }
     if (running == 0)
       break;
+    // Only this call's own children are reaped (several suites may run at once in threads).
     int st = 0;
-    const pid_t pid = waitpid(-1, &st, WNOHANG);
-    if (pid > 0 && live.count(pid)) {
+    pid_t pid = 0;
+    for (const auto& [p, k] : live)
+      if ((pid = waitpid(p, &st, WNOHANG)) > 0)
+        break;
+    if (pid > 0) {
       Job& j = jobs[live[pid]];
       live.erase(pid);
       --running;

@@ -320,3 +320,54 @@ TEST(CalibrationFile, ShippedTargetsLoadAndBadFilesExitWithTwo) {
   EXPECT_NE(msg.find("empty bounds"), std::string::npos) << msg;
   EXPECT_FALSE(std::filesystem::exists(out)) << "a bad file writes nothing";
 }
+
+// mpirun -np 2 shares each evaluation's replicate suites between two ranks and reaches the same
+// card and convergence table as two local processes (--jobs 2). Where MPI is installed.
+TEST(CalibrationCli, MpiRanksReachTheResultOfLocalJobs) {
+#ifndef ROCKLAB_MPIEXEC
+  GTEST_SKIP() << "built without MPI (libopenmpi-dev, openmpi-bin)";
+#else
+  namespace fs = std::filesystem;
+  const fs::path dir = rocklab::test::scratch_root() / "calibrate_mpi";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const nlohmann::json j{
+      {"name", "tiny-mpi"},
+      {"units", "SI"},
+      {"material", rocklab::test::source_dir() + "/tests/data/lab_2d_fj.json"},
+      {"targets",
+       {{"youngs_modulus_Pa", {{"value", 3e9}, {"tolerance", 0.05}}},
+        {"ucs_Pa", {{"value", 20e6}, {"tolerance", 0.05}}}}},
+      {"parameters",
+       {{"flatjoint.fj_emod", {{"role", "modulus"}, {"bounds", {1e8, 1e12}}}},
+        {"flatjoint.fj_ten", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}},
+        {"flatjoint.fj_coh", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}}}},
+      {"tests",
+       {{{"name", "ucs"}, {"test", "ucs"}, {"output", {{"vtk", false}, {"plots", false}}}}}},
+      {"seeds", {1, 2}},
+      {"budget", {{"elastic", 2}, {"strength", 2}, {"ratios", 0}, {"polish", 0}}}};
+  const std::string file = (dir / "tiny.json").string();
+  std::ofstream(file) << j.dump(2);
+  const std::string bin = rocklab::test::binary() + " calibrate " + file + " -o ";
+  std::string local, ranks;
+  const int st_local =
+      rocklab::test::run_command(bin + (dir / "jobs").string() + " --jobs 2", &local);
+  // Root may run mpirun here (CI containers); one node's shared memory, cores or not.
+  const std::string mpi =
+      "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
+      "OMPI_MCA_btl_vader_single_copy_mechanism=none " ROCKLAB_MPIEXEC " -np 2 --oversubscribe ";
+  const int st_mpi = rocklab::test::run_command(mpi + bin + (dir / "mpi").string(), &ranks);
+  ASSERT_TRUE(st_local == 0 || st_local == 1) << local;
+  EXPECT_EQ(st_mpi, st_local) << ranks;
+  // One summary, from rank 0 (mpirun adds its own lines about the exit status 1).
+  EXPECT_EQ(std::regex_search(ranks, std::regex("calibration .*\n(.|\n)*calibration ")), false)
+      << ranks;
+  for (const char* f : {"card.json", "convergence.csv"})
+    EXPECT_EQ(rocklab::test::read_file(dir / "mpi" / f), rocklab::test::read_file(dir / "jobs" / f))
+        << f;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(ranks, m, std::regex(R"(\((\d+) suites run, (\d+) cached\))")))
+      << ranks;
+  EXPECT_GE(std::stoi(m[1]), 6) << "every evaluation runs two replicate suites";
+#endif
+}

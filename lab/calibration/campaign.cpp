@@ -109,6 +109,8 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
                    " from " + fs::path(c.material_file).filename().string() + " (" +
                    (cs.outcome.met ? "every target met" : "not every target met") +
                    "; see report.md).";
+  if (o.ranks && !o.ranks->root())
+    return cs; // rank 0 writes the outputs
   const fs::path out(o.out_dir);
   write_text_file(out / "card.json", card.dump(2) + "\n");
   write_text_file(out / "convergence.csv", convergence_csv(c, cs.outcome));

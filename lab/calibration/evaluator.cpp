@@ -4,10 +4,12 @@
 #include "lab/suite.hpp"
 #include "materials/material_card.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+#include <thread>
 
 namespace fs = std::filesystem;
 
@@ -23,46 +25,98 @@ nlohmann::json Evaluator::tests_of(Stage s) const {
   return out;
 }
 
+void Evaluator::run_suites(const nlohmann::json& card, const std::vector<const Replicate*>& todo) {
+  if (todo.empty())
+    return;
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int jobs = o_.jobs > 0 ? o_.jobs : cores;
+  // Several replicate suites at once, each with its share of the processes and of the cores.
+  const int at_once = std::min(static_cast<int>(todo.size()), jobs);
+  std::atomic<std::size_t> next{0};
+  std::vector<std::exception_ptr> errors(todo.size());
+  auto worker = [&] {
+    for (std::size_t i; (i = next.fetch_add(1)) < todo.size();) {
+      try {
+        const Replicate& r = *todo[i];
+        fs::create_directories(r.dir);
+        std::ofstream(r.dir / "card.json") << card.dump(2) << "\n";
+        const nlohmann::json suite{{"name", c_.name + "-" + r.dir.filename().string()},
+                                   {"units", "SI"},
+                                   {"material", "card.json"},
+                                   {"parallel", std::max(1, jobs / at_once)},
+                                   {"tests", r.tests}};
+        std::ofstream(r.dir / "suite.json") << suite.dump(2) << "\n";
+        SuiteOptions so;
+        so.out_dir = (r.dir / "suite").string();
+        so.executable = o_.executable;
+        so.threads = std::max(1, cores / jobs);
+        so.interrupt = o_.interrupt;
+        run_suite(load_suite((r.dir / "suite.json").string()), so);
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < at_once; ++t)
+    pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool)
+    t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e)
+      std::rethrow_exception(e);
+}
+
 Evaluation Evaluator::run(const std::vector<double>& values, Stage s) {
   const nlohmann::json card = apply_params(c_.material, c_.params, values);
-  const nlohmann::json tests = tests_of(s);
-  std::map<std::string, std::vector<double>> all;
-  Evaluation ev;
+  std::vector<Replicate> reps;
   for (std::uint64_t seed : c_.seeds) {
-    nlohmann::json ts = tests;
+    nlohmann::json ts = tests_of(s);
     for (auto& t : ts)
       t["seed"] = seed;
     // The cache key: everything the result depends on.
     const std::string key =
         text_hash(card.dump() + "|" + ts.dump() + "|" + ROCKLAB_VERSION).substr(0, 16);
-    const fs::path dir = fs::path(o_.out_dir) / "evaluations" / key;
-    const fs::path suite_out = dir / "suite";
-    if (fs::exists(suite_out / "summary.json")) {
-      ++ev.cached;
-      ++cached_;
-    } else {
-      fs::create_directories(dir);
-      std::ofstream(dir / "card.json") << card.dump(2) << "\n";
-      const nlohmann::json suite{{"name", c_.name + "-" + key},
-                                 {"units", "SI"},
-                                 {"material", "card.json"},
-                                 {"parallel", o_.jobs},
-                                 {"tests", ts}};
-      std::ofstream(dir / "suite.json") << suite.dump(2) << "\n";
-      SuiteOptions so;
-      so.out_dir = suite_out.string();
-      so.executable = o_.executable;
-      so.interrupt = o_.interrupt;
-      run_suite(load_suite((dir / "suite.json").string()), so);
-      if (o_.interrupt && o_.interrupt->load())
-        throw std::runtime_error("interrupted");
-      ++run_;
-    }
+    reps.push_back({fs::path(o_.out_dir) / "evaluations" / key, ts});
+  }
+  // Which replicates are cached is decided once (rank 0) so that every rank shares out the same
+  // list; this rank runs every size-th of the missing ones.
+  std::string missing;
+  for (const Replicate& r : reps)
+    missing += fs::exists(r.dir / "suite" / "summary.json") ? '0' : '1';
+  const Ranks* ranks = o_.ranks;
+  if (ranks)
+    missing = ranks->broadcast(missing);
+  const int size = ranks ? ranks->size() : 1, rank = ranks ? ranks->rank() : 0;
+  std::vector<const Replicate*> mine;
+  for (std::size_t i = 0, k = 0; i < reps.size(); ++i)
+    if (missing[i] == '1' && static_cast<int>(k++ % size) == rank)
+      mine.push_back(&reps[i]);
+  std::exception_ptr failed;
+  try {
+    run_suites(card, mine);
+  } catch (...) {
+    failed = std::current_exception();
+  }
+  if (ranks ? !ranks->all(!failed) : static_cast<bool>(failed)) { // every rank stops together
+    if (failed)
+      std::rethrow_exception(failed);
+    throw std::runtime_error("a suite failed on another MPI rank");
+  }
+  if (o_.interrupt && o_.interrupt->load())
+    throw std::runtime_error("interrupted");
+  Evaluation ev;
+  std::map<std::string, std::vector<double>> all;
+  for (std::size_t i = 0; i < reps.size(); ++i) {
+    (missing[i] == '1' ? run_ : ev.cached) += 1;
+    const fs::path suite_out = reps[i].dir / "suite";
     ev.folders.push_back(suite_out.string());
     const nlohmann::json sm = read_json_file((suite_out / "summary.json").string());
     for (const auto& [k, v] : sm["properties"].items())
       all[k].push_back(v.is_number() ? v.get<double>() : std::nan(""));
   }
+  cached_ += ev.cached;
   for (const auto& [k, v] : all) {
     double m = 0, q = 0;
     for (double x : v)

@@ -4,8 +4,10 @@
 #pragma once
 
 #include "lab/calibration/calibration_file.hpp"
+#include "lab/calibration/ranks.hpp"
 
 #include <atomic>
+#include <filesystem>
 #include <string>
 
 namespace rocklab::calibration {
@@ -13,8 +15,9 @@ namespace rocklab::calibration {
 struct EvaluatorOptions {
   std::string out_dir;    ///< evaluations go to OUT_DIR/evaluations/HASH/
   std::string executable; ///< the rocklab binary that runs each test
-  int jobs = 0;           ///< test processes at once (0: one per core)
+  int jobs = 0;           ///< test processes at once on this rank (0: one per core)
   const std::atomic<bool>* interrupt = nullptr;
+  const Ranks* ranks = nullptr; ///< MPI ranks sharing the suites (nullptr: this process only)
 };
 
 /// Properties of one evaluation: the mean over seeds, and their standard deviations under the
@@ -35,6 +38,14 @@ public:
   int suites_cached() const { return cached_; }
 
 private:
+  /// One replicate: its cache folder and suite (tests with this seed).
+  struct Replicate {
+    std::filesystem::path dir;
+    nlohmann::json tests;
+  };
+  /// Runs the suites of these replicates, up to `jobs` test processes at once in all.
+  void run_suites(const nlohmann::json& card, const std::vector<const Replicate*>& todo);
+
   const CalibrationFile& c_;
   EvaluatorOptions o_;
   int run_ = 0, cached_ = 0;

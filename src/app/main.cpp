@@ -181,8 +181,12 @@ int calibrate_command(const std::string& file, const std::string& out_dir, bool 
   o.executable = std::filesystem::read_symlink("/proc/self/exe").string();
   o.jobs = jobs;
   o.interrupt = &g_interrupt;
+  const rocklab::calibration::Ranks ranks; // MPI when started by mpirun
+  o.ranks = &ranks;
+  if (ranks.size() > 1 && jobs == 0)
+    o.jobs = 1; // one test process per rank unless asked: mpirun places the ranks on the cores
   const rocklab::calibration::CampaignSummary cs = rocklab::calibration::run_campaign(file, o);
-  if (!quiet)
+  if (!quiet && ranks.root())
     std::printf("calibration  %s: %zu evaluations (%d suites run, %d cached), %.1f s\n"
                 "wrote        %s/card.json, report.md, convergence.csv\n",
                 cs.outcome.met ? "every target met" : "NOT every target met",
@@ -224,8 +228,10 @@ int info_command() {
       tests += ", ";
     tests += name;
   }
-  std::printf("rocklab %s\nthreads %d\ncontact models: %s\nlab tests: %s\nunits: SI\n",
-              ROCKLAB_VERSION, omp_get_max_threads(), models.c_str(), tests.c_str());
+  std::printf("rocklab %s\nthreads %d\ncontact models: %s\nlab tests: %s\nMPI (calibrate): %s\n"
+              "units: SI\n",
+              ROCKLAB_VERSION, omp_get_max_threads(), models.c_str(), tests.c_str(),
+              rocklab::calibration::Ranks::available() ? "yes" : "no");
   return 0;
 }
 
@@ -244,7 +250,8 @@ CLI::App* add_calibrate(CLI::App& app, CalibrateArgs& a, bool& quiet) {
                    "keeps every evaluation in OUT/evaluations/ (a rerun reuses them)");
   c->add_option("calibration", a.file, "Calibration file (JSON)")->required();
   c->add_option("-o,--out", a.out, "Output directory")->required();
-  c->add_option("--jobs", a.jobs, "Test processes at once (0: one per core)")
+  c->add_option("--jobs", a.jobs,
+                "Test processes at once (0: one per core; under mpirun: per rank)")
       ->check(CLI::NonNegativeNumber);
   c->add_flag("-q,--quiet", quiet, "No summary");
   c->add_flag("--check", a.check, "Check the file and print the plan; run nothing");

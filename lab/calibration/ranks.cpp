@@ -1,0 +1,89 @@
+#include "lab/calibration/ranks.hpp"
+
+#include <cstdlib>
+#include <stdexcept>
+#include <vector>
+
+#ifdef ROCKLAB_HAVE_MPI
+#include <mpi.h>
+#endif
+
+namespace rocklab::calibration {
+
+namespace {
+
+// Open MPI, MPICH/Hydra and Slurm's PMI each leave one of these in a launched process.
+bool launched_by_mpi() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK"})
+    if (std::getenv(v))
+      return true;
+  return false;
+}
+
+} // namespace
+
+#ifdef ROCKLAB_HAVE_MPI
+
+Ranks::Ranks() {
+  if (!launched_by_mpi())
+    return;
+  int provided = 0;
+  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
+  started_ = true;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+}
+
+Ranks::~Ranks() {
+  if (started_)
+    MPI_Finalize();
+}
+
+bool Ranks::all(bool ok) const {
+  if (size_ == 1)
+    return ok;
+  int in = ok ? 1 : 0, out = 0;
+  MPI_Allreduce(&in, &out, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  return out == 1;
+}
+
+std::string Ranks::broadcast(const std::string& text) const {
+  if (size_ == 1)
+    return text;
+  unsigned long long n = text.size();
+  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+  std::vector<char> buf(text.begin(), text.end());
+  buf.resize(n);
+  MPI_Bcast(buf.data(), static_cast<int>(n), MPI_CHAR, 0, MPI_COMM_WORLD);
+  return std::string(buf.begin(), buf.end());
+}
+
+bool Ranks::available() {
+  return true;
+}
+
+#else
+
+Ranks::Ranks() {
+  // Several copies of one campaign writing one OUTDIR would spoil it: refuse instead.
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+    if (const char* n = std::getenv(v); n && std::atoi(n) > 1)
+      throw std::runtime_error(std::string("started by an MPI launcher with ") + n +
+                               " ranks, but this rocklab was built without MPI (install "
+                               "libopenmpi-dev and build again, or use --jobs N)");
+  (void)launched_by_mpi;
+}
+Ranks::~Ranks() = default;
+bool Ranks::all(bool ok) const {
+  return ok;
+}
+std::string Ranks::broadcast(const std::string& text) const {
+  return text;
+}
+bool Ranks::available() {
+  return false;
+}
+
+#endif
+
+} // namespace rocklab::calibration
