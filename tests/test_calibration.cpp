@@ -284,6 +284,20 @@ TEST(CalibrationCli, TinyCalibrationMeetsItsTargetsAndResumesFromItsCache) {
   EXPECT_NE(card["source"].get<std::string>().find("every target met"), std::string::npos);
   const std::string report = rocklab::test::read_file(dir / "out" / "report.md");
   EXPECT_NE(report.find("| youngs_modulus_Pa | 3e+09 | 5 % |"), std::string::npos) << report;
+  // The sensitivity table: E follows the flat-joint modulus (the linear springs' does not move),
+  // and neither strength moves E.
+  std::smatch row;
+  ASSERT_TRUE(std::regex_search(
+      report, row, std::regex(R"(\| flatjoint\.fj_emod \| \+10 % \| (\S+) \| (\S+) \|)")))
+      << report;
+  EXPECT_GT(std::stod(row[2]), 0.4) << report; // columns in the order of the targets
+  EXPECT_LT(std::stod(row[2]), 1.1) << report;
+  ASSERT_TRUE(std::regex_search(
+      report, row, std::regex(R"(\| flatjoint\.fj_ten \| \+10 % \| (\S+) \| (\S+) \|)")))
+      << report;
+  EXPECT_LT(std::abs(std::stod(row[2])), 0.05) << report;
+  const std::string svg = rocklab::test::read_file(dir / "out" / "convergence.svg");
+  EXPECT_NE(svg.find("<polyline"), std::string::npos);
   // The fitted card is a valid material card, and a rerun runs nothing and writes the same card.
   ASSERT_EQ(rocklab::test::run_command(
                 rocklab::test::binary() + " calibrate " + file + " -o " + out + " --jobs 1", &msg),

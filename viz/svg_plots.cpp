@@ -73,7 +73,7 @@ struct Range1 {
 std::string line_plot_svg(const std::string& title, const std::string& xlabel,
                           const std::string& ylabel, const std::string& y2label,
                           const std::vector<PlotSeries>& series,
-                          const std::vector<PlotMarker>& markers) {
+                          const std::vector<PlotMarker>& markers, double y_top) {
   const double W = 760, H = 480, L = 80, R = y2label.empty() ? 30 : 80, T = 50, B = 60;
   Range1 rx, ry, ry2;
   bool has2 = false;
@@ -84,6 +84,8 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
       has2 = has2 || s.right_axis;
     }
   rx.finish();
+  if (std::isfinite(y_top))
+    ry.add(y_top);
   ry.finish();
   ry2.finish();
   const double pw = W - L - R, ph = H - T - B;
@@ -145,8 +147,9 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
   for (const PlotMarker& m : markers) {
     s += "<circle cx=\"" + num(X(m.x)) + "\" cy=\"" + num(Y(m.y, false)) +
          "\" r=\"4\" fill=\"none\" stroke=\"black\"/>\n";
-    s += "<text x=\"" + num(X(m.x) + 6) + "\" y=\"" + num(Y(m.y, false) - 6) + "\">" +
-         escape(m.label) + "</text>\n";
+    const bool right = X(m.x) > L + 0.85 * pw; // keep the label inside the picture
+    s += "<text x=\"" + num(X(m.x) + (right ? -6 : 6)) + "\" y=\"" + num(Y(m.y, false) - 6) + "\"" +
+         (right ? " text-anchor=\"end\"" : "") + ">" + escape(m.label) + "</text>\n";
   }
   s += "</svg>\n";
   return s;

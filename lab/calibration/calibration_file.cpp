@@ -189,6 +189,7 @@ CalibrationFile load_calibration(const std::string& path) {
   c.budget.strength = static_cast<int>(b.integer("strength", 0, 100, c.budget.strength));
   c.budget.ratios = static_cast<int>(b.integer("ratios", 0, 1000, c.budget.ratios));
   c.budget.polish = static_cast<int>(b.integer("polish", 0, 100, c.budget.polish));
+  c.budget.sensitivity = b.boolean("sensitivity", c.budget.sensitivity);
   b.finish();
   top.finish();
   return c;

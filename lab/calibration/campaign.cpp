@@ -1,13 +1,13 @@
 #include "lab/calibration/campaign.hpp"
 
 #include "io/output_dir.hpp"
-#include "io/results.hpp"
+#include "lab/calibration/report.hpp"
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
+
+#include <sys/resource.h>
 
 namespace fs = std::filesystem;
 
@@ -15,106 +15,87 @@ namespace rocklab::calibration {
 
 namespace {
 
-std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
+// CPU seconds of the finished child processes (the tests) of this process.
+double children_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
-double worst_error(const std::vector<Target>& targets, const Measured& m) {
-  double w = 0;
-  for (const Target& t : targets) {
-    const auto it = m.find(t.property);
-    w = std::max(w, std::abs(t.error(it == m.end() ? std::nan("") : it->second)));
-  }
-  return w;
-}
-
-std::string convergence_csv(const CalibrationFile& c, const Outcome& out) {
-  std::string s = "evaluation,stage";
-  for (const CardParam& p : c.params)
-    s += "," + p.key;
-  for (const Target& t : c.targets)
-    s += "," + t.property;
-  s += ",worst_error_in_tolerances\n";
-  for (const Record& r : out.history) {
-    s += std::to_string(r.evaluation) + "," + stage_name(r.stage);
-    for (double v : r.values)
-      s += "," + format_double(v);
-    for (const Target& t : c.targets) {
-      const auto it = r.measured.find(t.property);
-      s += "," + (it == r.measured.end() ? std::string() : format_double(it->second));
-    }
-    s += "," + format_double(worst_error(c.targets, r.measured)) + "\n";
-  }
-  return s;
-}
-
-std::string report_md(const CalibrationFile& c, const CampaignSummary& cs, const Measured& sd) {
-  const Outcome& out = cs.outcome;
-  std::string s = "# Calibration report: " + c.name + "\n\nUnits SI. Calibration file `" + c.file +
-                  "`, base card `" + c.material_file + "`; " + std::to_string(c.seeds.size()) +
-                  " replicate seed(s) per evaluation; " + std::to_string(out.history.size()) +
-                  " evaluations (" + std::to_string(cs.suites_run) + " suites run, " +
-                  std::to_string(cs.suites_cached) + " from the cache), " + fmt(cs.wall_seconds) +
-                  " s wall time.\n\n";
-  s += std::string("**") + (out.met ? "Every target met." : "Not every target met.") + "**\n\n";
-  s += "| target | value | tolerance | achieved (mean ± sd over seeds) | error / tolerance |\n";
-  s += "|---|---|---|---|---|\n";
-  for (const Target& t : c.targets) {
-    const auto it = out.measured.find(t.property);
-    const double m = it == out.measured.end() ? std::nan("") : it->second;
-    const auto is = sd.find(t.property);
-    s += "| " + t.property + " | " + fmt(t.value) + " | " +
-         (t.absolute ? "± " + fmt(t.tolerance) : fmt(100 * t.tolerance) + " %") + " | " + fmt(m) +
-         " ± " + fmt(is == sd.end() ? std::nan("") : is->second) + " | " + fmt(t.error(m)) + " |\n";
-  }
-  s += "\n| parameter | role | start | final | bounds |\n|---|---|---|---|---|\n";
-  for (std::size_t i = 0; i < c.params.size(); ++i) {
+// One single-seed run per parameter, that parameter moved by +10 % (-10 % at its upper bound;
+// by a tenth of its bounds when it is 0), against the same seed at the optimum.
+Sensitivity sensitivity(Evaluator& ev, const CalibrationFile& c, const std::vector<double>& x) {
+  Sensitivity sv;
+  sv.seed = c.seeds.front();
+  const Measured base = ev.run(x, Stage::Final, 1).mean;
+  for (std::size_t i = 0; i < x.size(); ++i) {
     const Param& p = c.params[i].param;
-    s += "| " + p.name + " | " + role_name(p.role) + " | " + fmt(p.value) + " | " +
-         fmt(out.params[i].value) + " | [" + fmt(p.lo) + ", " + fmt(p.hi) + "] |\n";
+    std::vector<double> y = x;
+    y[i] = x[i] != 0 ? x[i] * 1.1 : 0.1 * (p.hi - p.lo);
+    if (y[i] > p.hi)
+      y[i] = x[i] * 0.9;
+    const double rel = x[i] != 0 ? (y[i] - x[i]) / x[i] : 1.0;
+    const Measured m = ev.run(y, Stage::Final, 1).mean;
+    std::vector<double> row;
+    for (const Target& t : c.targets) {
+      const auto a = base.find(t.property), b = m.find(t.property);
+      row.push_back(a == base.end() || b == m.end() ? std::nan("")
+                                                    : (b->second - a->second) / a->second / rel);
+    }
+    sv.step.push_back(rel);
+    sv.per.push_back(row);
   }
-  s += "\nconvergence.csv has every evaluation (stage, parameters, measured targets, worst "
-       "error).\n";
-  return s;
+  return sv;
 }
 
 } // namespace
 
 CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = children_cpu_seconds();
   const CalibrationFile c = load_calibration(file);
   fs::create_directories(o.out_dir);
   Evaluator ev(c, o);
   std::vector<Param> params;
   for (const CardParam& p : c.params)
     params.push_back(p.param);
-  Measured last_sd;
+  Evaluation last;
   const Evaluate evaluate = [&](const std::vector<double>& v, Stage s) {
-    const Evaluation e = ev.run(v, s);
-    last_sd = e.sd;
-    return e.mean;
+    last = ev.run(v, s);
+    return last.mean;
   };
   CampaignSummary cs;
   cs.outcome = calibrate(params, c.targets, evaluate, c.budget);
-  cs.suites_run = ev.suites_run();
-  cs.suites_cached = ev.suites_cached();
-  cs.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ReportInput r;
+  r.file = &c;
+  r.outcome = &cs.outcome;
+  r.sd = last.sd;
+  r.final_folders = last.folders;
   std::vector<double> values;
   for (const Param& p : cs.outcome.params)
     values.push_back(p.value);
+  if (c.budget.sensitivity)
+    r.sensitivity = sensitivity(ev, c, values);
+  cs.suites_run = r.suites_run = ev.suites_run();
+  cs.suites_cached = r.suites_cached = ev.suites_cached();
+  cs.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.wall_seconds = cs.wall_seconds;
+  r.cpu_seconds = children_cpu_seconds() - cpu0;
+  if (o.ranks)
+    r.cpu_seconds = o.ranks->sum(r.cpu_seconds);
+  if (o.ranks && !o.ranks->root())
+    return cs; // rank 0 writes the outputs
   nlohmann::json card = apply_params(c.material, c.params, values);
   card["source"] = "Calibrated by rocklab calibrate " + fs::path(file).filename().string() +
                    " from " + fs::path(c.material_file).filename().string() + " (" +
                    (cs.outcome.met ? "every target met" : "not every target met") +
                    "; see report.md).";
-  if (o.ranks && !o.ranks->root())
-    return cs; // rank 0 writes the outputs
   const fs::path out(o.out_dir);
   write_text_file(out / "card.json", card.dump(2) + "\n");
   write_text_file(out / "convergence.csv", convergence_csv(c, cs.outcome));
-  write_text_file(out / "report.md", report_md(c, cs, last_sd));
+  write_text_file(out / "convergence.svg", convergence_svg(c, cs.outcome));
+  write_text_file(out / "report.md", report_md(r));
   return cs;
 }
 

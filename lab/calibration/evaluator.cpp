@@ -68,10 +68,12 @@ void Evaluator::run_suites(const nlohmann::json& card, const std::vector<const R
       std::rethrow_exception(e);
 }
 
-Evaluation Evaluator::run(const std::vector<double>& values, Stage s) {
+Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_t seeds) {
   const nlohmann::json card = apply_params(c_.material, c_.params, values);
   std::vector<Replicate> reps;
   for (std::uint64_t seed : c_.seeds) {
+    if (reps.size() >= seeds)
+      break;
     nlohmann::json ts = tests_of(s);
     for (auto& t : ts)
       t["seed"] = seed;

@@ -7,6 +7,7 @@
 #include "lab/calibration/ranks.hpp"
 
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -33,7 +34,8 @@ public:
   Evaluator(const CalibrationFile& c, EvaluatorOptions o) : c_(c), o_(std::move(o)) {}
   /// The tests of a stage: Elastic and Strength run the UCS tests only, Ratios and Final all.
   nlohmann::json tests_of(Stage s) const;
-  Evaluation run(const std::vector<double>& values, Stage s);
+  /// Runs (or finds in the cache) the tests of stage `s` on the first `seeds` replicate seeds.
+  Evaluation run(const std::vector<double>& values, Stage s, std::size_t seeds = SIZE_MAX);
   int suites_run() const { return run_; }
   int suites_cached() const { return cached_; }
 

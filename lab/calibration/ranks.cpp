@@ -47,6 +47,14 @@ bool Ranks::all(bool ok) const {
   return out == 1;
 }
 
+double Ranks::sum(double v) const {
+  if (size_ == 1)
+    return v;
+  double out = 0;
+  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  return out;
+}
+
 std::string Ranks::broadcast(const std::string& text) const {
   if (size_ == 1)
     return text;
@@ -76,6 +84,9 @@ Ranks::Ranks() {
 Ranks::~Ranks() = default;
 bool Ranks::all(bool ok) const {
   return ok;
+}
+double Ranks::sum(double v) const {
+  return v;
 }
 std::string Ranks::broadcast(const std::string& text) const {
   return text;

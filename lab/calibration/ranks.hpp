@@ -22,6 +22,8 @@ public:
   bool root() const { return rank_ == 0; }
   /// True on every rank when `ok` is true on every rank (a collective: every rank must call it).
   bool all(bool ok) const;
+  /// The sum over the ranks (a collective).
+  double sum(double v) const;
   /// Rank 0's text on every rank (a collective).
   std::string broadcast(const std::string& text) const;
   /// Whether this binary was built with MPI (`rocklab info`).

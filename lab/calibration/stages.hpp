@@ -72,6 +72,7 @@ struct Outcome {
 /// defaults add up to at most 36 with the final evaluation.
 struct Budget {
   int elastic = 6, strength = 4, ratios = 20, polish = 2;
+  bool sensitivity = true; ///< afterwards, one single-seed run per parameter (the report's table)
 };
 
 Outcome calibrate(std::vector<Param> params, const std::vector<Target>& targets,
