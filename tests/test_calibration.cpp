@@ -314,7 +314,14 @@ TEST(CalibrationFile, ShippedTargetsLoadAndBadFilesExitWithTwo) {
   const std::string shipped = rocklab::test::source_dir() + "/lab/calibrate/lac_du_bonnet_2d.json";
   const CalibrationFile c = load_calibration(shipped);
   EXPECT_EQ(c.targets.size(), 7u);
-  EXPECT_EQ(c.params.size(), 7u);
+  EXPECT_EQ(c.params.size(), 8u);
+  // Every shipped calibration file loads (its card, parameters and tests agree).
+  for (const char* f :
+       {"lac_du_bonnet.json", "berea.json", "acceptance/lac_du_bonnet_2d_2x_off.json"})
+    EXPECT_NO_THROW(load_calibration(rocklab::test::source_dir() + "/lab/calibrate/" + f)) << f;
+  EXPECT_EQ(
+      load_calibration(rocklab::test::source_dir() + "/lab/calibrate/berea.json").targets.size(),
+      4u);
   std::string msg;
   EXPECT_EQ(rocklab::test::run_command(rocklab::test::binary() + " calibrate " + shipped + " -o " +
                                            (rocklab::test::scratch_root() / "chk").string() +

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include <sys/resource.h>
@@ -49,6 +50,24 @@ Sensitivity sensitivity(Evaluator& ev, const CalibrationFile& c, const std::vect
   return sv;
 }
 
+// One line per evaluation: each measured target and its error in tolerances, the worst, the time.
+void print_progress(int n, Stage s, const CalibrationFile& c, const Evaluation& e,
+                    std::chrono::steady_clock::duration took) {
+  std::string line;
+  for (const Target& t : c.targets)
+    if (const auto it = e.mean.find(t.property); it != e.mean.end() && std::isfinite(it->second)) {
+      char b[96];
+      std::snprintf(b, sizeof b, " %s %.4g (%+.1f)", t.property.c_str(), it->second,
+                    t.error(it->second));
+      line += b;
+    }
+  std::fprintf(stderr,
+               "[rocklab calibrate] %d %s:%s; worst %.2f tolerances; %zu seed(s), %d "
+               "cached, %.0f s\n",
+               n, stage_name(s), line.c_str(), worst_error(c.targets, e.mean), e.folders.size(),
+               e.cached, std::chrono::duration<double>(took).count());
+}
+
 } // namespace
 
 CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o) {
@@ -61,8 +80,12 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   for (const CardParam& p : c.params)
     params.push_back(p.param);
   Evaluation last;
+  int count = 0;
   const Evaluate evaluate = [&](const std::vector<double>& v, Stage s) {
+    const auto t = std::chrono::steady_clock::now();
     last = ev.run(v, s);
+    if (o.progress && (!o.ranks || o.ranks->root()))
+      print_progress(++count, s, c, last, std::chrono::steady_clock::now() - t);
     return last.mean;
   };
   CampaignSummary cs;
@@ -75,8 +98,14 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   std::vector<double> values;
   for (const Param& p : cs.outcome.params)
     values.push_back(p.value);
-  if (c.budget.sensitivity)
+  if (c.budget.sensitivity) {
+    if (o.progress && (!o.ranks || o.ranks->root()))
+      std::fprintf(stderr,
+                   "[rocklab calibrate] sensitivity: %zu single-seed runs, one per "
+                   "parameter\n",
+                   values.size());
     r.sensitivity = sensitivity(ev, c, values);
+  }
   cs.suites_run = r.suites_run = ev.suites_run();
   cs.suites_cached = r.suites_cached = ev.suites_cached();
   cs.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -19,6 +19,7 @@ struct EvaluatorOptions {
   int jobs = 0;           ///< test processes at once on this rank (0: one per core)
   const std::atomic<bool>* interrupt = nullptr;
   const Ranks* ranks = nullptr; ///< MPI ranks sharing the suites (nullptr: this process only)
+  bool progress = false;        ///< one line per evaluation on stderr (rank 0)
 };
 
 /// Properties of one evaluation: the mean over seeds, and their standard deviations under the

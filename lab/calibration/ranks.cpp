@@ -1,7 +1,9 @@
 #include "lab/calibration/ranks.hpp"
 
+#include <chrono>
 #include <cstdlib>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #ifdef ROCKLAB_HAVE_MPI
@@ -24,6 +26,18 @@ bool launched_by_mpi() {
 
 #ifdef ROCKLAB_HAVE_MPI
 
+namespace {
+
+// Waits for a non-blocking collective by polling with short sleeps: a rank waiting for another
+// rank's tests must not busy-poll a core those tests need (blocking collectives spin).
+void finish(MPI_Request& req) {
+  int done = 0;
+  for (MPI_Test(&req, &done, MPI_STATUS_IGNORE); !done; MPI_Test(&req, &done, MPI_STATUS_IGNORE))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+}
+
+} // namespace
+
 Ranks::Ranks() {
   if (!launched_by_mpi())
     return;
@@ -43,7 +57,9 @@ bool Ranks::all(bool ok) const {
   if (size_ == 1)
     return ok;
   int in = ok ? 1 : 0, out = 0;
-  MPI_Allreduce(&in, &out, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  MPI_Request req;
+  MPI_Iallreduce(&in, &out, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD, &req);
+  finish(req);
   return out == 1;
 }
 
@@ -51,7 +67,9 @@ double Ranks::sum(double v) const {
   if (size_ == 1)
     return v;
   double out = 0;
-  MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+  MPI_Request req;
+  MPI_Iallreduce(&v, &out, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD, &req);
+  finish(req);
   return out;
 }
 
@@ -59,10 +77,13 @@ std::string Ranks::broadcast(const std::string& text) const {
   if (size_ == 1)
     return text;
   unsigned long long n = text.size();
-  MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+  MPI_Request req;
+  MPI_Ibcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD, &req);
+  finish(req);
   std::vector<char> buf(text.begin(), text.end());
   buf.resize(n);
-  MPI_Bcast(buf.data(), static_cast<int>(n), MPI_CHAR, 0, MPI_COMM_WORLD);
+  MPI_Ibcast(buf.data(), static_cast<int>(n), MPI_CHAR, 0, MPI_COMM_WORLD, &req);
+  finish(req);
   return std::string(buf.begin(), buf.end());
 }
 

@@ -87,8 +87,9 @@ std::string sensitivity_table(const ReportInput& r) {
 double worst_error(const std::vector<Target>& targets, const Measured& m) {
   double w = 0;
   for (const Target& t : targets) {
-    const double e = std::abs(t.error(measured(m, t.property)));
-    w = std::max(w, std::isfinite(e) ? e : INFINITY);
+    const double v = measured(m, t.property);
+    if (m.count(t.property))
+      w = std::max(w, std::isfinite(v) ? std::abs(t.error(v)) : INFINITY);
   }
   return w;
 }

@@ -29,7 +29,8 @@ struct ReportInput {
   double wall_seconds = 0, cpu_seconds = 0;
 };
 
-/// The worst |error| in tolerances over the targets (NaN measured counts as infinite).
+/// The worst |error| in tolerances over the targets this evaluation measured (a test that gave
+/// no value, NaN, counts as infinite).
 double worst_error(const std::vector<Target>& targets, const Measured& m);
 std::string convergence_csv(const CalibrationFile& c, const Outcome& out);
 std::string convergence_svg(const CalibrationFile& c, const Outcome& out);

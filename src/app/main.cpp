@@ -183,12 +183,13 @@ int calibrate_command(const std::string& file, const std::string& out_dir, bool 
   o.interrupt = &g_interrupt;
   const rocklab::calibration::Ranks ranks; // MPI when started by mpirun
   o.ranks = &ranks;
+  o.progress = !quiet;
   if (ranks.size() > 1 && jobs == 0)
     o.jobs = 1; // one test process per rank unless asked: mpirun places the ranks on the cores
   const rocklab::calibration::CampaignSummary cs = rocklab::calibration::run_campaign(file, o);
   if (!quiet && ranks.root())
     std::printf("calibration  %s: %zu evaluations (%d suites run, %d cached), %.1f s\n"
-                "wrote        %s/card.json, report.md, convergence.csv\n",
+                "wrote        %s/card.json, report.md, convergence.csv, convergence.svg\n",
                 cs.outcome.met ? "every target met" : "NOT every target met",
                 cs.outcome.history.size(), cs.suites_run, cs.suites_cached, cs.wall_seconds,
                 out_dir.c_str());
