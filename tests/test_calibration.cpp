@@ -220,26 +220,32 @@ TEST(CalibrationFile, BadFilesNameTheKeyAndWhatIsAllowed) {
 // rocklab calibrate end to end on a tiny 2D specimen: E and UCS from a card 2-4x off; a run
 // interrupted after its first evaluation resumes from the cache; a rerun runs nothing.
 
+// A calibration of the tiny 2D flat-jointed specimen's E and UCS (its card is 2-4x off).
+nlohmann::json tiny_calibration(const std::string& name, const std::vector<int>& seeds, int elastic,
+                                int strength, int polish) {
+  return {{"name", name},
+          {"units", "SI"},
+          {"material", rocklab::test::source_dir() + "/tests/data/lab_2d_fj.json"},
+          {"targets",
+           {{"youngs_modulus_Pa", {{"value", 3e9}, {"tolerance", 0.05}}},
+            {"ucs_Pa", {{"value", 20e6}, {"tolerance", 0.05}}}}},
+          {"parameters",
+           {{"flatjoint.fj_emod", {{"role", "modulus"}, {"bounds", {1e8, 1e12}}}},
+            {"flatjoint.fj_ten", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}},
+            {"flatjoint.fj_coh", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}}}},
+          {"tests",
+           {{{"name", "ucs"}, {"test", "ucs"}, {"output", {{"vtk", false}, {"plots", false}}}}}},
+          {"seeds", seeds},
+          {"budget",
+           {{"elastic", elastic}, {"strength", strength}, {"ratios", 0}, {"polish", polish}}}};
+}
+
 TEST(CalibrationCli, TinyCalibrationMeetsItsTargetsAndResumesFromItsCache) {
   namespace fs = std::filesystem;
   const fs::path dir = rocklab::test::scratch_root() / "calibrate";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const nlohmann::json j{
-      {"name", "tiny"},
-      {"units", "SI"},
-      {"material", rocklab::test::source_dir() + "/tests/data/lab_2d_fj.json"},
-      {"targets",
-       {{"youngs_modulus_Pa", {{"value", 3e9}, {"tolerance", 0.05}}},
-        {"ucs_Pa", {{"value", 20e6}, {"tolerance", 0.05}}}}},
-      {"parameters",
-       {{"flatjoint.fj_emod", {{"role", "modulus"}, {"bounds", {1e8, 1e12}}}},
-        {"flatjoint.fj_ten", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}},
-        {"flatjoint.fj_coh", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}}}},
-      {"tests",
-       {{{"name", "ucs"}, {"test", "ucs"}, {"output", {{"vtk", false}, {"plots", false}}}}}},
-      {"seeds", {1}},
-      {"budget", {{"elastic", 4}, {"strength", 4}, {"ratios", 0}, {"polish", 1}}}};
+  const nlohmann::json j = tiny_calibration("tiny", {1}, 4, 4, 1);
   const std::string file = (dir / "tiny.json").string(), out = (dir / "out").string();
   std::ofstream(file) << j.dump(2);
   // Interrupt once the first evaluation is in the cache.
@@ -352,21 +358,7 @@ TEST(CalibrationCli, MpiRanksReachTheResultOfLocalJobs) {
   const fs::path dir = rocklab::test::scratch_root() / "calibrate_mpi";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const nlohmann::json j{
-      {"name", "tiny-mpi"},
-      {"units", "SI"},
-      {"material", rocklab::test::source_dir() + "/tests/data/lab_2d_fj.json"},
-      {"targets",
-       {{"youngs_modulus_Pa", {{"value", 3e9}, {"tolerance", 0.05}}},
-        {"ucs_Pa", {{"value", 20e6}, {"tolerance", 0.05}}}}},
-      {"parameters",
-       {{"flatjoint.fj_emod", {{"role", "modulus"}, {"bounds", {1e8, 1e12}}}},
-        {"flatjoint.fj_ten", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}},
-        {"flatjoint.fj_coh", {{"role", "strength"}, {"bounds", {1e5, 1e10}}}}}},
-      {"tests",
-       {{{"name", "ucs"}, {"test", "ucs"}, {"output", {{"vtk", false}, {"plots", false}}}}}},
-      {"seeds", {1, 2}},
-      {"budget", {{"elastic", 2}, {"strength", 2}, {"ratios", 0}, {"polish", 0}}}};
+  const nlohmann::json j = tiny_calibration("tiny-mpi", {1, 2}, 2, 2, 0);
   const std::string file = (dir / "tiny.json").string();
   std::ofstream(file) << j.dump(2);
   const std::string bin = rocklab::test::binary() + " calibrate " + file + " -o ";
