@@ -369,6 +369,10 @@ TEST(CalibrationCli, MpiRanksReachTheResultOfLocalJobs) {
   const std::string mpi =
       "env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 "
       "OMPI_MCA_btl_vader_single_copy_mechanism=none " ROCKLAB_MPIEXEC " -np 2 --oversubscribe ";
+  // A machine where mpirun cannot start two processes at all (no usable launcher) is not
+  // where this can be tested; say so rather than fail.
+  if (std::string probe; rocklab::test::run_command(mpi + "true", &probe) != 0)
+    GTEST_SKIP() << "mpirun cannot start two processes here: " << probe;
   const int st_mpi = rocklab::test::run_command(mpi + bin + (dir / "mpi").string(), &ranks);
   ASSERT_TRUE(st_local == 0 || st_local == 1) << local;
   EXPECT_EQ(st_mpi, st_local) << ranks;
