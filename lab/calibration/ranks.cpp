@@ -7,6 +7,8 @@
 #include <vector>
 
 #ifdef ROCKLAB_HAVE_MPI
+#define OMPI_SKIP_MPICXX 1 // the C API only (the deprecated C++ bindings warn)
+#define MPICH_SKIP_MPICXX 1
 #include <mpi.h>
 #endif
 
