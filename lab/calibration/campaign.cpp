@@ -38,11 +38,10 @@ Sensitivity sensitivity(Evaluator& ev, const CalibrationFile& c, const std::vect
       y[i] = x[i] * 0.9;
     const double rel = x[i] != 0 ? (y[i] - x[i]) / x[i] : 1.0;
     const Measured m = ev.run(y, Stage::Final, 1).mean;
-    std::vector<double> row;
+    std::vector<double> row; // NaN where either run did not measure the target
     for (const Target& t : c.targets) {
-      const auto a = base.find(t.property), b = m.find(t.property);
-      row.push_back(a == base.end() || b == m.end() ? std::nan("")
-                                                    : (b->second - a->second) / a->second / rel);
+      const double a = value_of(base, t.property);
+      row.push_back((value_of(m, t.property) - a) / a / rel);
     }
     sv.step.push_back(rel);
     sv.per.push_back(row);
@@ -55,10 +54,9 @@ void print_progress(int n, Stage s, const CalibrationFile& c, const Evaluation& 
                     std::chrono::steady_clock::duration took) {
   std::string line;
   for (const Target& t : c.targets)
-    if (const auto it = e.mean.find(t.property); it != e.mean.end() && std::isfinite(it->second)) {
+    if (const double v = value_of(e.mean, t.property); std::isfinite(v)) {
       char b[96];
-      std::snprintf(b, sizeof b, " %s %.4g (%+.1f)", t.property.c_str(), it->second,
-                    t.error(it->second));
+      std::snprintf(b, sizeof b, " %s %.4g (%+.1f)", t.property.c_str(), v, t.error(v));
       line += b;
     }
   std::fprintf(stderr,

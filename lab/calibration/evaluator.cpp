@@ -1,13 +1,13 @@
 #include "lab/calibration/evaluator.hpp"
 
 #include "io/json_input.hpp"
+#include "io/output_dir.hpp"
 #include "lab/suite.hpp"
 #include "materials/material_card.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <thread>
 
@@ -39,13 +39,13 @@ void Evaluator::run_suites(const nlohmann::json& card, const std::vector<const R
       try {
         const Replicate& r = *todo[i];
         fs::create_directories(r.dir);
-        std::ofstream(r.dir / "card.json") << card.dump(2) << "\n";
+        write_text_file(r.dir / "card.json", card.dump(2) + "\n");
         const nlohmann::json suite{{"name", c_.name + "-" + r.dir.filename().string()},
                                    {"units", "SI"},
                                    {"material", "card.json"},
                                    {"parallel", std::max(1, jobs / at_once)},
                                    {"tests", r.tests}};
-        std::ofstream(r.dir / "suite.json") << suite.dump(2) << "\n";
+        write_text_file(r.dir / "suite.json", suite.dump(2) + "\n");
         SuiteOptions so;
         so.out_dir = (r.dir / "suite").string();
         so.executable = o_.executable;

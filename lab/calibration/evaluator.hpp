@@ -22,8 +22,8 @@ struct EvaluatorOptions {
   bool progress = false;        ///< one line per evaluation on stderr (rank 0)
 };
 
-/// Properties of one evaluation: the mean over seeds, and their standard deviations under the
-/// same keys with "_sd" appended.
+/// Properties of one evaluation: the mean over the seeds and the sample standard deviation
+/// (0 for one seed), by property name.
 struct Evaluation {
   Measured mean, sd;
   std::vector<std::string> folders; ///< the suites' output folders, one per seed

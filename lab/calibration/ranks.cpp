@@ -14,6 +14,8 @@
 
 namespace rocklab::calibration {
 
+#ifdef ROCKLAB_HAVE_MPI
+
 namespace {
 
 // Open MPI, MPICH/Hydra and Slurm's PMI each leave one of these in a launched process.
@@ -23,12 +25,6 @@ bool launched_by_mpi() {
       return true;
   return false;
 }
-
-} // namespace
-
-#ifdef ROCKLAB_HAVE_MPI
-
-namespace {
 
 // Waits for a non-blocking collective by polling with short sleeps: a rank waiting for another
 // rank's tests must not busy-poll a core those tests need (blocking collectives spin).
@@ -102,7 +98,6 @@ Ranks::Ranks() {
       throw std::runtime_error(std::string("started by an MPI launcher with ") + n +
                                " ranks, but this rocklab was built without MPI (install "
                                "libopenmpi-dev and build again, or use --jobs N)");
-  (void)launched_by_mpi;
 }
 Ranks::~Ranks() = default;
 bool Ranks::all(bool ok) const {

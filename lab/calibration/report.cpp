@@ -17,21 +17,16 @@ std::string fmt(double v, const char* f = "%.4g") {
   return b;
 }
 
-double measured(const Measured& m, const std::string& key) {
-  const auto it = m.find(key);
-  return it == m.end() ? std::nan("") : it->second;
-}
-
 std::string targets_table(const ReportInput& r) {
   const CalibrationFile& c = *r.file;
   std::string s = "| target | value | tolerance | achieved (mean ± sd over seeds) | error / "
                   "tolerance |\n|---|---|---|---|---|\n";
   for (const Target& t : c.targets) {
-    const double m = measured(r.outcome->measured, t.property);
+    const double m = value_of(r.outcome->measured, t.property);
     s += "| " + t.property + " | " + fmt(t.value) + " | ";
     s += t.absolute ? "± " + fmt(t.tolerance) : fmt(100 * t.tolerance) + " %";
     s +=
-        " | " + fmt(m) + " ± " + fmt(measured(r.sd, t.property)) + " | " + fmt(t.error(m)) + " |\n";
+        " | " + fmt(m) + " ± " + fmt(value_of(r.sd, t.property)) + " | " + fmt(t.error(m)) + " |\n";
   }
   return s;
 }
@@ -75,7 +70,7 @@ std::string sensitivity_table(const ReportInput& r) {
   // What the packing alone does: the seed-to-seed spread relative to the mean, per unit step.
   s += "| *seed-to-seed sd / mean ÷ 10 %* | |";
   for (const Target& t : c.targets) {
-    const double m = measured(r.outcome->measured, t.property), sd = measured(r.sd, t.property);
+    const double m = value_of(r.outcome->measured, t.property), sd = value_of(r.sd, t.property);
     s.append(" *").append(fmt(std::abs(sd / m) / 0.1, "%.2f")).append("* |");
   }
   return s + "\n\nAn entry smaller than the last row's can be the packing's noise: a different "
@@ -87,7 +82,7 @@ std::string sensitivity_table(const ReportInput& r) {
 double worst_error(const std::vector<Target>& targets, const Measured& m) {
   double w = 0;
   for (const Target& t : targets) {
-    const double v = measured(m, t.property);
+    const double v = value_of(m, t.property);
     if (m.count(t.property))
       w = std::max(w, std::isfinite(v) ? std::abs(t.error(v)) : INFINITY);
   }
@@ -105,10 +100,10 @@ std::string convergence_csv(const CalibrationFile& c, const Outcome& out) {
     s.append(std::to_string(r.evaluation)).append(",").append(stage_name(r.stage));
     for (double v : r.values)
       s.append(",").append(format_double(v));
-    for (const Target& t : c.targets) {
-      const auto it = r.measured.find(t.property);
-      s.append(",").append(it == r.measured.end() ? std::string() : format_double(it->second));
-    }
+    for (const Target& t : c.targets)
+      s.append(",").append(r.measured.count(t.property)
+                               ? format_double(value_of(r.measured, t.property))
+                               : std::string());
     s.append(",").append(format_double(worst_error(c.targets, r.measured))).append("\n");
   }
   return s;
@@ -127,7 +122,7 @@ std::string convergence_svg(const CalibrationFile& c, const Outcome& out) {
     p.color = colors[k % 8];
     p.dashed = k >= 8;
     for (const Record& r : out.history) {
-      const double m = measured(r.measured, c.targets[k].property);
+      const double m = value_of(r.measured, c.targets[k].property);
       if (std::isfinite(m)) {
         p.x.push_back(r.evaluation);
         p.y.push_back(std::min(kClip, std::abs(c.targets[k].error(m))));

@@ -14,6 +14,11 @@ double Target::error(double measured) const {
   return absolute ? (measured - value) / tolerance : (measured / value - 1) / tolerance;
 }
 
+double value_of(const Measured& m, const std::string& key) {
+  const auto it = m.find(key);
+  return it == m.end() ? std::nan("") : it->second;
+}
+
 const char* stage_name(Stage s) {
   switch (s) {
   case Stage::Elastic:
@@ -48,11 +53,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool is_stress(const std::string& property) {
   return property.size() > 3 && property.ends_with("_Pa") && property != kYoungs;
-}
-
-double value_of(const Measured& m, const std::string& key) {
-  const auto it = m.find(key);
-  return it == m.end() ? std::nan("") : it->second;
 }
 
 struct Campaign {

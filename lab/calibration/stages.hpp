@@ -51,6 +51,8 @@ inline const char* const kUcs = "ucs_Pa";
 enum class Stage { Elastic, Strength, Ratios, Final };
 
 using Measured = std::map<std::string, double>;
+/// A measured property, NaN when the evaluation did not measure it.
+double value_of(const Measured& m, const std::string& key);
 /// Runs the tests a stage needs for these parameter values (in the order of the Param list).
 using Evaluate = std::function<Measured(const std::vector<double>& values, Stage stage)>;
 

@@ -247,8 +247,8 @@ struct CalibrateArgs {
 CLI::App* add_calibrate(CLI::App& app, CalibrateArgs& a, bool& quiet) {
   CLI::App* c = app.add_subcommand(
       "calibrate", "Fit a material card's micro-parameters to laboratory targets "
-                   "(docs/calibration.md); writes OUT/card.json, report.md, convergence.csv and "
-                   "keeps every evaluation in OUT/evaluations/ (a rerun reuses them)");
+                   "(docs/calibration.md); writes OUT/card.json, report.md, convergence.csv/svg "
+                   "and keeps every evaluation in OUT/evaluations/ (a rerun reuses them)");
   c->add_option("calibration", a.file, "Calibration file (JSON)")->required();
   c->add_option("-o,--out", a.out, "Output directory")->required();
   c->add_option("--jobs", a.jobs,
