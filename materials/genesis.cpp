@@ -46,6 +46,7 @@ nlohmann::json GenesisReport::to_json() const {
   return {{"units", "SI"},
           {"grains", grains},
           {"floaters", floaters},
+          {"escaped_grains_removed", escaped},
           {"specimen", shape_json(shape, dim)},
           {"porosity_target", porosity_target},
           {"porosity_packed", porosity_packed},
@@ -100,7 +101,9 @@ GenesisResult run_genesis(const MaterialCard& card,
   genesis::Run run(card, m, rep, progress, interrupt);
   genesis::place_grains(run);
   genesis::relax_cloud(run);
+  genesis::remove_escaped(run);
   genesis::compact(run);
+  genesis::remove_escaped(run);
   genesis::remove_floaters(run);
   genesis::join_clumps(run);
   genesis::finalize_contacts(run);

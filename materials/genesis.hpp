@@ -15,6 +15,7 @@ namespace rocklab {
 struct GenesisReport {
   int dim = 3;
   std::int64_t grains = 0, floaters = 0;
+  std::int64_t escaped = 0; ///< grains removed because their centre left the vessel
   std::int64_t contacts = 0, fj_bonded = 0, fj_gapped = 0, fj_slit = 0, pb_bonded = 0,
                cb_bonded = 0, clumps = 0, linear = 0, smoothjoint = 0;
   ShapeSpec shape; ///< the specimen: the vessel at the end of installation, or the cut [m]

@@ -1,5 +1,6 @@
 // Genesis stage "floaters": grains with fewer than 3 (3D) or 2 (2D) force-carrying contacts are
-// counted (and removed if the card asks); the coordination number is counted without them.
+// counted (and removed if the card asks); the coordination number is counted without them. Also
+// the grains that escaped the vessel are removed.
 #include "materials/genesis/stages.hpp"
 
 #include <algorithm>
@@ -40,6 +41,28 @@ void remove_floaters(Run& g) {
     rep.coordination = live > 0 ? 2.0 * static_cast<double>(bb) / live : 0;
     if (card.eliminate_floaters && rep.floaters > 0)
       m.remove_balls(floater);
+  }
+}
+
+void remove_escaped(Run& g) {
+  // Relaxing a random cloud can squeeze a grain so hard against a vessel wall that its centre
+  // crosses the wall's plane; the two-sided wall then pushes it out and it flies off with no
+  // contact. Left in place it ends up in the specimen file tens of millimetres from the rock,
+  // where the lab's platens (placed at the outermost grains) would start from it and hit the
+  // specimen at the seating servo's full speed. Such grains are not part of the rock: remove them.
+  Model& m = g.m;
+  std::vector<bool> out(m.balls.size(), false);
+  std::int64_t n = 0;
+  for (std::size_t i = 0; i < m.balls.size(); ++i)
+    if (!g.vessel.holds(m, m.balls.pos[i])) {
+      out[i] = true;
+      ++n;
+    }
+  if (n > 0) {
+    m.remove_balls(out);
+    g.rep.escaped += n;
+    if (g.rep.porosity_installed > 0) // after installation: what it reached, without them
+      g.rep.porosity = g.rep.porosity_installed = g.porosity_now();
   }
 }
 

@@ -50,6 +50,9 @@ struct Vessel {
   double stress(const Model& m, const Servo& s) const;
   /// The vessel as a specimen shape (its size now).
   ShapeSpec shape_now(const Model& m) const;
+  /// Whether point x lies inside every wall of the vessel (on the inner side of each plane, within
+  /// the round wall's radius).
+  bool holds(const Model& m, const Vec3& x) const;
 };
 
 /// Add the vessel of the card's specimen shape to the model, every length times `scale`.
@@ -111,10 +114,12 @@ struct Run {
 };
 
 // The stages, in order (the file that holds each).
-void place_grains(Run& g);      ///< cloud.cpp: radii, a cloud in the enlarged vessel, Morton order
-void relax_cloud(Run& g);       ///< packing.cpp: soft packing springs, the cloud relaxed
-void compact(Run& g);           ///< compaction.cpp: to the porosity at the pressure, installed
-void remove_floaters(Run& g);   ///< floaters.cpp: count floaters, coordination; remove if asked
+void place_grains(Run& g);    ///< cloud.cpp: radii, a cloud in the enlarged vessel, Morton order
+void relax_cloud(Run& g);     ///< packing.cpp: soft packing springs, the cloud relaxed
+void compact(Run& g);         ///< compaction.cpp: to the porosity at the pressure, installed
+void remove_floaters(Run& g); ///< floaters.cpp: count floaters, coordination; remove if asked
+/// floaters.cpp: remove grains whose centre has left the vessel (after the cloud and compaction)
+void remove_escaped(Run& g);
 void join_clumps(Run& g);       ///< clumps.cpp: touching grains into rigid clumps (thesis App. B)
 void finalize_contacts(Run& g); ///< finalization.cpp: bonds where the gap is within g_i
 void release(Run& g);           ///< release.cpp: unload and remove the vessel, cut, relax

@@ -110,6 +110,21 @@ ShapeSpec Vessel::shape_now(const Model& m) const {
   return s;
 }
 
+bool Vessel::holds(const Model& m, const Vec3& x) const {
+  for (const Servo& s : servos) {
+    const Wall& w = m.walls[s.wall];
+    if (s.radial) {
+      Vec3 r = x - w.center;
+      r -= r.dot(w.axis) * w.axis;
+      if (r.norm() > w.cylinder_radius)
+        return false;
+    } else if ((x - w.center).dot(s.n_in) < 0) {
+      return false;
+    }
+  }
+  return true;
+}
+
 // The vessel of the card's specimen shape, every length multiplied by `scale`.
 Vessel make_vessel(Model& m, const MaterialCard& card, double scale) {
   Vessel v;
