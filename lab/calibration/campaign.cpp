@@ -3,6 +3,7 @@
 #include "io/output_dir.hpp"
 #include "lab/calibration/report.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -53,17 +54,25 @@ Sensitivity sensitivity(Evaluator& ev, const CalibrationFile& c, const std::vect
 void print_progress(int n, Stage s, const CalibrationFile& c, const Evaluation& e,
                     std::chrono::steady_clock::duration took) {
   std::string line;
+  double worst = 0;
+  int unmeasured = 0; // targets whose tests this stage does not run
   for (const Target& t : c.targets)
     if (const double v = value_of(e.mean, t.property); std::isfinite(v)) {
       char b[96];
       std::snprintf(b, sizeof b, " %s %.4g (%+.1f)", t.property.c_str(), v, t.error(v));
       line += b;
+      worst = std::max(worst, std::abs(t.error(v)));
+    } else {
+      ++unmeasured;
     }
+  char tail[64] = "";
+  if (unmeasured > 0)
+    std::snprintf(tail, sizeof tail, " (%d target(s) not measured)", unmeasured);
   std::fprintf(stderr,
-               "[rocklab calibrate] %d %s:%s; worst %.2f tolerances; %zu seed(s), %d "
-               "cached, %.0f s\n",
-               n, stage_name(s), line.c_str(), worst_error(c.targets, e.mean), e.folders.size(),
-               e.cached, std::chrono::duration<double>(took).count());
+               "[rocklab calibrate] %d %s:%s; worst %.2f tolerances%s; %zu seed(s), %d cached, "
+               "%.0f s\n",
+               n, stage_name(s), line.c_str(), worst, tail, e.folders.size(), e.cached,
+               std::chrono::duration<double>(took).count());
 }
 
 } // namespace
