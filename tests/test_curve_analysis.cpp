@@ -117,7 +117,7 @@ TEST(CurveAnalysis, TwentyByFortyGraniteUcsGivesAPhysicalPoissonRatio) {
       {"units", "SI"},
       {"test", "ucs"},
       {"specimen",
-       {{"material", test::source_dir() + "/materials/granite_fj_2d.json"},
+       {{"material", test::source_dir() + "/tests/data/granite_fj_2d_uncalibrated.json"},
         {"shape", {{"shape", "rectangle"}, {"width", 0.02}, {"height", 0.04}}}}},
       {"loading", {{"strain_rate", 1.0}}},
       {"output", {{"history_every", 50}, {"vtk", false}, {"plots", false}}}};
