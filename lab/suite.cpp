@@ -294,6 +294,7 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
   if (j.status != 0) {
     failed = true;
     row["status"] = "failed";
+    row["exit_status"] = j.status;
     row["error"] = last_lines(j.log, 3);
     tests.push_back(row);
     csv += t.name + "," + row["test"].get<std::string>() + ",failed,,,,,,,,,,," +

@@ -1,5 +1,6 @@
 #include "lab/calibration/evaluator.hpp"
 
+#include "io/input_error.hpp"
 #include "io/json_input.hpp"
 #include "io/output_dir.hpp"
 #include "lab/suite.hpp"
@@ -7,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 #include <thread>
@@ -68,6 +70,28 @@ void Evaluator::run_suites(const nlohmann::json& card, const std::vector<const R
       std::rethrow_exception(e);
 }
 
+// A test that failed leaves its targets unmeasured. One that rejected its input (exit status 2:
+// e.g. a Brazilian disk whose vessel cannot reach the card's porosity) fails at every point, so the
+// campaign stops naming it; a physical failure at one trial point (blow-up, no peak) is said on
+// stderr and the point counts as missing its targets (the optimiser moves away from it).
+void Evaluator::check_tests(const nlohmann::json& summary, const fs::path& suite_out,
+                            const nlohmann::json& tests) const {
+  const std::uint64_t seed = tests.empty() ? 0 : tests[0].value("seed", std::uint64_t{0});
+  for (const auto& t : summary.value("tests", nlohmann::json::array())) {
+    if (t.value("status", "") == "ok")
+      continue;
+    std::string error = t.value("error", "");
+    while (!error.empty() && error.back() == '\n')
+      error.pop_back();
+    const std::string what = "test '" + t.value("name", "") + "' of seed " + std::to_string(seed) +
+                             " (" + suite_out.string() + ") failed: " + error;
+    if (t.value("exit_status", 0) == 2)
+      throw InputError(c_.file + ": " + what + " - fix this test in the calibration file");
+    if (!o_.ranks || o_.ranks->rank() == 0)
+      std::fprintf(stderr, "[rocklab calibrate] warning: %s\n", what.c_str());
+  }
+}
+
 Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_t seeds) {
   const nlohmann::json card = apply_params(c_.material, c_.params, values);
   std::vector<Replicate> reps;
@@ -115,6 +139,7 @@ Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_
     const fs::path suite_out = reps[i].dir / "suite";
     ev.folders.push_back(suite_out.string());
     const nlohmann::json sm = read_json_file((suite_out / "summary.json").string());
+    check_tests(sm, suite_out, reps[i].tests);
     for (const auto& [k, v] : sm["properties"].items())
       all[k].push_back(v.is_number() ? v.get<double>() : std::nan(""));
   }

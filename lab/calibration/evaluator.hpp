@@ -48,6 +48,8 @@ private:
   };
   /// Runs the suites of these replicates, up to `jobs` test processes at once in all.
   void run_suites(const nlohmann::json& card, const std::vector<const Replicate*>& todo);
+  void check_tests(const nlohmann::json& summary, const std::filesystem::path& suite_out,
+                   const nlohmann::json& tests) const;
 
   const CalibrationFile& c_;
   EvaluatorOptions o_;

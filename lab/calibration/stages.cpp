@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 
 namespace rocklab::calibration {
@@ -205,10 +206,20 @@ void Campaign::ratios(int budget) {
   opt.set_maxeval(budget);
   opt.set_initial_step(0.15);
   opt.set_xtol_abs(1e-3);
+  // NLopt's C++ wrapper swallows an exception thrown by the objective (it becomes a generic
+  // "nlopt failure"), so an interrupt or a rejected test is kept here and rethrown afterwards.
+  std::exception_ptr thrown;
   auto objective = [&](const std::vector<double>& x) {
     for (std::size_t k = 0; k < n; ++k)
       p[shape[k]].value = from_x(p[shape[k]], x[k]);
-    const Measured m = run(Stage::Ratios);
+    Measured m;
+    try {
+      m = run(Stage::Ratios);
+    } catch (...) {
+      thrown = std::current_exception();
+      opt.force_stop();
+      return HUGE_VAL;
+    }
     ++used;
     double worst;
     const double f = misfit(m, worst);
@@ -236,6 +247,8 @@ void Campaign::ratios(int budget) {
   } catch (const std::exception&) {
     // roundoff-limited or similar: the best point so far stands
   }
+  if (thrown)
+    std::rethrow_exception(thrown);
   for (std::size_t i = 0; i < p.size() && best_values.size() == p.size(); ++i)
     p[i].value = best_values[i];
 }
