@@ -42,6 +42,15 @@ Measured synthetic_rock(const std::vector<double>& v, double noise, std::mt19937
   return m;
 }
 
+// The synthetic rock's five parameters with their bounds, the shape parameters off by 2x.
+std::vector<Param> synthetic_params(double emod, double kratio, double ten) {
+  return {{"emod", Role::Modulus, 1e9, 1e12, emod},
+          {"kratio", Role::StiffnessRatio, 1.0, 8.0, kratio},
+          {"ten", Role::Strength, 1e6, 1e9, ten},
+          {"coh_over_ten", Role::Shape, 1.0, 20.0, 16.0},
+          {"slit", Role::Shape, 0.0, 0.5, 0.4}};
+}
+
 } // namespace
 
 TEST(Calibration, StagesFindAKnownRockFromTwiceWrongParametersWithNoise) {
@@ -56,11 +65,7 @@ TEST(Calibration, StagesFindAKnownRockFromTwiceWrongParametersWithNoise) {
       {"direct_tension_Pa", want.at("direct_tension_Pa"), 0.08},
       {"ucs_over_bts", want.at("ucs_over_bts"), 0.10},
       {"crack_initiation_over_ucs", want.at("crack_initiation_over_ucs"), 0.05}};
-  std::vector<Param> params{{"emod", Role::Modulus, 1e9, 1e12, 1.2e11},
-                            {"kratio", Role::StiffnessRatio, 1.0, 8.0, 5.0},
-                            {"ten", Role::Strength, 1e6, 1e9, 4e7},
-                            {"coh_over_ten", Role::Shape, 1.0, 20.0, 16.0},
-                            {"slit", Role::Shape, 0.0, 0.5, 0.4}};
+  std::vector<Param> params = synthetic_params(1.2e11, 5.0, 4e7);
   std::mt19937 rng(7);
   std::vector<Stage> seen;
   const Evaluate evaluate = [&](const std::vector<double>& v, Stage s) {
@@ -94,11 +99,7 @@ TEST(Calibration, StagesFindAKnownRockFromTwiceWrongParametersWithNoise) {
 TEST(Calibration, AnErrorInTheOptimiserStageIsNotSwallowed) {
   // NLopt's wrapper turns an exception from the objective into a generic failure; an interrupt or
   // a test that rejects its input during stage 3 must still stop the campaign with its own error.
-  std::vector<Param> params{{"emod", Role::Modulus, 1e9, 1e12, 6e10},
-                            {"kratio", Role::StiffnessRatio, 1.0, 8.0, 2.5},
-                            {"ten", Role::Strength, 1e6, 1e9, 2e7},
-                            {"coh_over_ten", Role::Shape, 1.0, 20.0, 16.0},
-                            {"slit", Role::Shape, 0.0, 0.5, 0.4}};
+  const std::vector<Param> params = synthetic_params(6e10, 2.5, 2e7);
   std::mt19937 rng_truth(1);
   const Measured want = synthetic_rock({6e10, 2.5, 2e7, 8.0, 0.2}, 0.0, rng_truth);
   const std::vector<Target> targets{{kUcs, want.at(kUcs), 0.05},
