@@ -213,6 +213,24 @@ TEST(CalibrationFile, ReadsTheFileAndSetsTheCard) {
   EXPECT_DOUBLE_EQ(card["linear"]["emod"].get<double>(), 1e11);
 }
 
+TEST(CalibrationFile, AFreeSlitFractionTakesItsShareFromTheBondedOne) {
+  // The granite card has bonded 0.9, gapped 0, slit 0.1; the three must keep summing to 1.
+  nlohmann::json j = good_calibration();
+  j["parameters"]["flatjoint.types.slit"] = {{"role", "shape"}, {"bounds", {0.0, 0.5}}};
+  const CalibrationFile c = load_calibration(write_calibration("slit", j));
+  std::vector<double> v;
+  for (const CardParam& p : c.params)
+    v.push_back(p.key == "flatjoint.types.slit" ? 0.35 : p.param.value);
+  const nlohmann::json card = apply_params(c.material, c.params, v);
+  EXPECT_DOUBLE_EQ(card["flatjoint"]["types"]["slit"].get<double>(), 0.35);
+  EXPECT_DOUBLE_EQ(card["flatjoint"]["types"]["bonded"].get<double>(), 0.65);
+  EXPECT_DOUBLE_EQ(card["flatjoint"]["types"]["gapped"].get<double>(), 0.0);
+  // Bounds that would leave a negative bonded fraction are refused, naming the allowed range.
+  j["parameters"]["flatjoint.types.slit"]["bounds"] = {0.0, 1.5};
+  EXPECT_NE(error_of(j).find("free within [0, 1 - gapped] = [0, 1]"), std::string::npos)
+      << error_of(j);
+}
+
 TEST(CalibrationFile, BadFilesNameTheKeyAndWhatIsAllowed) {
   nlohmann::json j = good_calibration();
   j["parameters"]["flatjoint.fj_nope"] = {{"role", "strength"}, {"bounds", {1, 2}}};
@@ -372,7 +390,7 @@ TEST(CalibrationFile, ShippedTargetsLoadAndBadFilesExitWithTwo) {
   const std::string shipped = rocklab::test::source_dir() + "/lab/calibrate/lac_du_bonnet_2d.json";
   const CalibrationFile c = load_calibration(shipped);
   EXPECT_EQ(c.targets.size(), 7u);
-  EXPECT_EQ(c.params.size(), 8u);
+  EXPECT_EQ(c.params.size(), 9u);
   // Every shipped calibration file loads (its card, parameters and tests agree).
   for (const char* f :
        {"lac_du_bonnet.json", "berea.json", "acceptance/lac_du_bonnet_2d_2x_off.json"})

@@ -63,6 +63,16 @@ Role role_of(JsonObject& o) {
                                   : Role::Shape;
 }
 
+// "flatjoint.types" for "flatjoint.types.slit" or "flatjoint.types.gapped", else "".
+std::string fraction_parent(const std::string& path) {
+  for (const char* leaf : {".types.slit", ".types.gapped"}) {
+    const std::string l = leaf;
+    if (path.size() > l.size() && path.compare(path.size() - l.size(), l.size(), l) == 0)
+      return path.substr(0, path.size() - l.size() + 6);
+  }
+  return "";
+}
+
 CardParam read_param(const CalibrationFile& c, JsonObject& top, const std::string& key) {
   JsonObject o = top.object(key);
   CardParam p;
@@ -97,6 +107,16 @@ CardParam read_param(const CalibrationFile& c, JsonObject& top, const std::strin
     top.fail(key, "the card's value " + format_double(start) + " lies outside the bounds [" +
                       format_double(p.param.lo) + ", " + format_double(p.param.hi) + "]");
   p.param.value = start;
+  if (const std::string types = fraction_parent(p.path); !types.empty()) {
+    // The bonded fraction takes the remainder, so it must stay >= 0 over the whole box.
+    const nlohmann::json& t = *card_value(c.material, types);
+    const bool slit = p.path.back() == 't';
+    const double other = t.value(slit ? "gapped" : "slit", 0.0);
+    if (!p.over.empty() || p.param.lo < 0 || p.param.hi + other > 1)
+      top.fail(key, "a microstructure fraction is free within [0, 1 - " +
+                        std::string(slit ? "gapped" : "slit") + "] = [0, " +
+                        format_double(1 - other) + "] (bonded takes the remainder), not a ratio");
+  }
   return p;
 }
 
@@ -221,6 +241,17 @@ nlohmann::json apply_params(const nlohmann::json& card, const std::vector<CardPa
       if (p.over.empty() != (pass == 0))
         continue;
       set(p.path, pass == 0 ? values[i] : values[i] * number_of(*card_value(out, p.over)));
+    }
+  // A free gapped or slit fraction takes its share from the bonded one (the three sum to 1).
+  for (const CardParam& p : params)
+    if (const std::string types = fraction_parent(p.path); !types.empty()) {
+      nlohmann::json* t = &out;
+      for (std::size_t a = 0; a < types.size();) {
+        const std::size_t b = std::min(types.find('.', a), types.size());
+        t = &(*t)[types.substr(a, b - a)];
+        a = b + 1;
+      }
+      (*t)["bonded"] = 1 - t->value("gapped", 0.0) - t->value("slit", 0.0);
     }
   return out;
 }
