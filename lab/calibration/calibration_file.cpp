@@ -47,6 +47,17 @@ const nlohmann::json* card_value(const nlohmann::json& card, const std::string& 
   return v;
 }
 
+// The card entry at "section.key", for writing.
+nlohmann::json& value_at(nlohmann::json& card, const std::string& path) {
+  nlohmann::json* v = &card;
+  for (std::size_t a = 0; a <= path.size();) {
+    const std::size_t b = std::min(path.find('.', a), path.size());
+    v = &(*v)[path.substr(a, b - a)];
+    a = b + 1;
+  }
+  return *v;
+}
+
 double number_of(const nlohmann::json& v) {
   if (v.is_number())
     return v.get<double>();
@@ -65,11 +76,9 @@ Role role_of(JsonObject& o) {
 
 // "flatjoint.types" for "flatjoint.types.slit" or "flatjoint.types.gapped", else "".
 std::string fraction_parent(const std::string& path) {
-  for (const char* leaf : {".types.slit", ".types.gapped"}) {
-    const std::string l = leaf;
-    if (path.size() > l.size() && path.compare(path.size() - l.size(), l.size(), l) == 0)
-      return path.substr(0, path.size() - l.size() + 6);
-  }
+  for (const std::string leaf : {".types.slit", ".types.gapped"})
+    if (path.size() > leaf.size() && path.ends_with(leaf))
+      return path.substr(0, path.rfind('.'));
   return "";
 }
 
@@ -110,7 +119,7 @@ CardParam read_param(const CalibrationFile& c, JsonObject& top, const std::strin
   if (const std::string types = fraction_parent(p.path); !types.empty()) {
     // The bonded fraction takes the remainder, so it must stay >= 0 over the whole box.
     const nlohmann::json& t = *card_value(c.material, types);
-    const bool slit = p.path.back() == 't';
+    const bool slit = p.path.ends_with(".slit");
     const double other = t.value(slit ? "gapped" : "slit", 0.0);
     if (!p.over.empty() || p.param.lo < 0 || p.param.hi + other > 1)
       top.fail(key, "a microstructure fraction is free within [0, 1 - " +
@@ -219,13 +228,7 @@ nlohmann::json apply_params(const nlohmann::json& card, const std::vector<CardPa
                             const std::vector<double>& values) {
   nlohmann::json out = card;
   auto set = [&](const std::string& path, double v) {
-    nlohmann::json* x = &out;
-    std::size_t a = 0;
-    while (a <= path.size()) {
-      const std::size_t b = std::min(path.find('.', a), path.size());
-      x = &(*x)[path.substr(a, b - a)];
-      a = b + 1;
-    }
+    nlohmann::json* x = &value_at(out, path);
     if (x->is_object()) { // a distribution keeps its coefficient of variation
       const double mean = (*x)["mean"].get<double>();
       if (x->contains("sd") && mean != 0)
@@ -245,13 +248,8 @@ nlohmann::json apply_params(const nlohmann::json& card, const std::vector<CardPa
   // A free gapped or slit fraction takes its share from the bonded one (the three sum to 1).
   for (const CardParam& p : params)
     if (const std::string types = fraction_parent(p.path); !types.empty()) {
-      nlohmann::json* t = &out;
-      for (std::size_t a = 0; a < types.size();) {
-        const std::size_t b = std::min(types.find('.', a), types.size());
-        t = &(*t)[types.substr(a, b - a)];
-        a = b + 1;
-      }
-      (*t)["bonded"] = 1 - t->value("gapped", 0.0) - t->value("slit", 0.0);
+      nlohmann::json& t = value_at(out, types);
+      t["bonded"] = 1 - t.value("gapped", 0.0) - t.value("slit", 0.0);
     }
   return out;
 }
