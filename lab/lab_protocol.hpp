@@ -36,6 +36,9 @@ public:
   /// Run a protocol file of this kind (`j` is its JSON). On any error nothing is left in
   /// OUTDIR. Throws InputError for bad input, PhysicsError for a blow-up.
   virtual LabSummary run(const nlohmann::json& j, const std::string& file, const LabOptions& o) = 0;
+  /// The revision of what this test measures: raised when the same inputs give different results
+  /// (a changed measurement rule), so that cached calibration evaluations of it run again.
+  virtual int revision() const { return 1; }
   /// The summary `rocklab test` prints on stdout.
   virtual void print(const LabSummary& s, const std::string& out_dir) const = 0;
 };

@@ -186,9 +186,13 @@ bool FrameRun::loop() {
   return true;
 }
 
-// The crack-initiation and crack-damage stresses on the axial curve, where results.json has them.
+// The crack-initiation and crack-damage stresses on the axial curve, where results.json has them;
+// a Brazilian test's tensile strength where it is not the peak (taken before the split).
 std::vector<PlotMarker> crack_markers(const LoadingFrame& f, const nlohmann::json& r) {
   std::vector<PlotMarker> m;
+  if (r.contains("split") && r["split"].contains("stress_Pa"))
+    m.push_back({100 * r["peak_axial_strain"].get<double>(),
+                 1e-6 * r["tensile_strength_Pa"].get<double>(), "tensile strength (before split)"});
   if (!r.contains("crack_stresses"))
     return m;
   const nlohmann::json& c = r["crack_stresses"];
@@ -267,6 +271,7 @@ void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::t
   nlohmann::json r = f.results();
   r["protocol"] = p.file;
   r["provenance"] = {{"rocklab_version", ROCKLAB_VERSION},
+                     {"test_revision", test.revision()},
                      {"material", meta.value("material_name", "")},
                      {"material_file", meta.value("material_file", "")},
                      {"material_hash", meta.value("material_hash", "")},
@@ -355,9 +360,17 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
                   1e-6 * r["confinement_measured_Pa"]["min"].get<double>(),
                   1e-6 * r["confinement_measured_Pa"]["max"].get<double>());
   }
-  if (r.contains("tensile_strength_Pa"))
-    std::printf("tensile strength %.4g MPa (peak force %.4g N)\n", mpa("tensile_strength_Pa"),
+  if (r.contains("tensile_strength_Pa") && r["tensile_strength_Pa"].is_number()) {
+    std::printf("tensile strength %.4g MPa (force %.4g N)", mpa("tensile_strength_Pa"),
                 r["peak_force_N"].get<double>());
+    if (r.contains("split") && r["split"]["peak_step"] > r["split"]["step"])
+      std::printf(" before the split; the halves then carried up to %.4g MPa",
+                  1e-6 * r["split"]["peak_Pa"].get<double>());
+    std::printf("\n");
+  } else if (r.contains("tensile_strength_Pa")) {
+    std::printf("tensile strength not measured (no split); 2F/(pi D t) peaked at %.4g MPa\n",
+                1e-6 * r["split"]["peak_Pa"].get<double>());
+  }
   const auto& c = r["cracks"];
   std::printf("cracks       %lld tension, %lld shear (%lld at peak)\n",
               static_cast<long long>(c["tension"].get<std::int64_t>()),

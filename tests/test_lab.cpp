@@ -4,10 +4,12 @@
 
 #include "io/json_input.hpp"
 #include "io/specimen.hpp"
+#include "lab/protocols/brazilian.hpp"
 #include "lab/run_test.hpp"
 #include "lab/suite.hpp"
 #include "viz/vtk_output.hpp"
 
+#include <array>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
@@ -271,13 +273,14 @@ TEST(Lab, TriaxialHoldsTheConfinementAndPeakRisesWithIt) {
 }
 
 TEST(Lab, BrazilianAndDirectTension) {
+  const fs::path bz_out = scratch("bz");
   const LabSummary bz = run(
       "bz",
       {{"test", "brazilian"},
        {"specimen",
         {{"material", data("lab_2d_fj.json")}, {"shape", {{"shape", "disk"}, {"diameter", 0.02}}}}},
        {"output", {{"vtk", false}}}},
-      scratch("bz"));
+      bz_out);
   const nlohmann::json& b = bz.results;
   // BTS = 2F / (pi D t), t = 1 m in 2D.
   EXPECT_TRUE(test::near_rel(b["tensile_strength_Pa"].get<double>(),
@@ -290,7 +293,44 @@ TEST(Lab, BrazilianAndDirectTension) {
   ASSERT_TRUE(b.contains("split")) << b.dump(1);
   EXPECT_TRUE(b["split"]["found"].get<bool>()) << b["stop_reason"];
   EXPECT_NE(b["stop_reason"].get<std::string>().find("split"), std::string::npos);
-  EXPECT_GE(b["split"]["step"].get<std::int64_t>(), b["peak_step"].get<std::int64_t>());
+  // The tensile strength is the largest load up to the crack that completed the split: that
+  // crack (cracks.csv) makes six adjacent tenths of the loaded diameter cracked within 0.2 D of
+  // it, the cracks before it do not, and no history row before it carries more load.
+  const std::int64_t split = b["split"]["step"].get<std::int64_t>();
+  const double d = b["specimen"]["diameter_m"].get<double>();
+  std::array<bool, 10> bins{};
+  auto longest = [&] {
+    int run = 0, best = 0;
+    for (bool x : bins)
+      best = std::max(best, run = x ? run + 1 : 0);
+    return best;
+  };
+  const auto cracks = read_csv(bz_out / "cracks.csv");
+  const double cx = b["specimen"]["center_m"][0].get<double>();
+  const double cy = b["specimen"]["center_m"][1].get<double>();
+  int before = 0;
+  for (std::size_t i = 1; i < cracks.size(); ++i) {
+    const std::int64_t step = std::stoll(cracks[i][1]);
+    if (step > split)
+      break;
+    if (step < split)
+      before = longest();
+    const double x = std::stod(cracks[i][2]) - cx, y = std::stod(cracks[i][3]) - cy;
+    if (std::abs(x) <= 0.2 * d)
+      bins[static_cast<std::size_t>(std::clamp(static_cast<int>((y + 0.5 * d) / d * 10), 0, 9))] =
+          true;
+  }
+  EXPECT_GE(longest(), 6);
+  EXPECT_LT(before, 6);
+  const double bts = b["tensile_strength_Pa"].get<double>();
+  EXPECT_LE(bts, b["split"]["peak_Pa"].get<double>());
+  EXPECT_LE(b["tensile_strength_step"].get<std::int64_t>(), split);
+  const auto hist = read_csv(bz_out / "history.csv");
+  for (std::size_t i = 1; i < hist.size(); ++i) {
+    if (std::stoll(hist[i][1]) <= split) {
+      EXPECT_LE(std::stod(hist[i][6]), bts * (1 + 1e-12)) << "history row " << i;
+    }
+  }
   const LabSummary dt = run("dt",
                             {{"test", "direct_tension"},
                              {"specimen", {{"file", specimen("lab_2d_fj")}}},
@@ -300,6 +340,50 @@ TEST(Lab, BrazilianAndDirectTension) {
   EXPECT_GT(dt.results["cracks"]["tension"].get<int>(), 0);
   // Tension is far weaker than compression in a flat-jointed rock.
   EXPECT_LT(dt.results["tensile_strength_Pa"].get<double>(), 5e6);
+}
+
+TEST(Lab, BrazilianStrengthIsTheLoadBeforeTheSplitNotTheHalvesLoadedAfterIt) {
+  SpecimenGeometry g;
+  g.dim = 2, g.diametral = true;
+  g.center = Vec3(0.1, 0.2, 0);
+  g.width0 = Vec3(0.02, 0.02, 0); // D = 20 mm: tenths of 2 mm, the split band |x| <= 4 mm
+  std::vector<Crack> cracks;
+  auto crack = [&](std::int64_t step, double x, double y) {
+    Crack c;
+    c.step = step, c.mode = 1, c.position = g.center + Vec3(x, y, 0);
+    cracks.push_back(c);
+  };
+  crack(100, 0, -0.0095), crack(200, 0, 0.0095); // crushing at both platens: tenths 0 and 9
+  crack(300, 0.001, -0.001), crack(310, 0, 0.001), crack(320, 0, -0.003);
+  crack(330, -0.002, 0.003), crack(340, 0, -0.005); // tenths 2-6: five in a run
+  crack(345, 0.008, -0.007);                        // tenth 1 but 8 mm off the diameter
+  crack(350, 0.0035, 0.005);                        // tenth 7: six in a run, the split
+  crack(360, 0, 0.007);
+  EXPECT_EQ(split_crack_step(cracks, g, 0.6), 350);
+  EXPECT_EQ(split_crack_step(cracks, g, 0.7), 360); // tenths 2-8
+  EXPECT_EQ(split_crack_step(cracks, g, 0.9), -1);
+  EXPECT_EQ(split_crack_step({cracks.begin(), cracks.begin() + 2}, g, 0.2), -1); // ends only
+  // The load climbs to 20 MPa, the disk splits at step 350, the halves then carry 30 MPa.
+  std::vector<LabSample> samples;
+  for (std::int64_t step = 0; step <= 600; step += 10) {
+    LabSample s;
+    s.step = step;
+    s.load = step <= 340   ? 20e6 * step / 340.0
+             : step <= 400 ? 12e6
+                           : 12e6 + 18e6 * (step - 400) / 200.0;
+    s.force = 1e3 * s.load;
+    samples.push_back(s);
+  }
+  PeakRecord peak;
+  peak.step = 600, peak.load = 30e6, peak.force = 3e10;
+  const LabSample before = strongest_before(samples, peak, 350);
+  EXPECT_EQ(before.step, 340);
+  EXPECT_DOUBLE_EQ(before.load, 20e6);
+  EXPECT_DOUBLE_EQ(before.force, 2e10);
+  // A peak before the split is the strength itself (exact, between two readings).
+  peak.step = 335, peak.load = 20.5e6;
+  EXPECT_DOUBLE_EQ(strongest_before(samples, peak, 350).load, 20.5e6);
+  EXPECT_LT(strongest_before(samples, peak, -1).load, 0); // no split, no strength
 }
 
 TEST(Lab, EnvelopeFitRecoversMohrCoulombAndHoekBrown) {

@@ -3,6 +3,7 @@
 #include "io/input_error.hpp"
 #include "io/json_input.hpp"
 #include "io/output_dir.hpp"
+#include "lab/protocol_table.hpp"
 #include "lab/suite.hpp"
 #include "materials/material_card.hpp"
 
@@ -101,9 +102,17 @@ Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_
     nlohmann::json ts = tests_of(s);
     for (auto& t : ts)
       t["seed"] = seed;
-    // The cache key: everything the result depends on.
+    // The cache key: everything the result depends on, with the revision of each test's
+    // measurement rules where it was raised (older keys stay valid for the other tests).
+    std::string revisions;
+    for (const auto& t : ts)
+      if (const auto p = make_lab_protocol(t.value("test", "")); p && p->revision() > 1) {
+        revisions += '|';
+        revisions += p->name();
+        revisions += " r" + std::to_string(p->revision());
+      }
     const std::string key =
-        text_hash(card.dump() + "|" + ts.dump() + "|" + ROCKLAB_VERSION).substr(0, 16);
+        text_hash(card.dump() + "|" + ts.dump() + "|" + ROCKLAB_VERSION + revisions).substr(0, 16);
     reps.push_back({fs::path(o_.out_dir) / "evaluations" / key, ts});
   }
   // Which replicates are cached is decided once (rank 0) so that every rank shares out the same

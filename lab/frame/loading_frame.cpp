@@ -387,6 +387,9 @@ nlohmann::json LoadingFrame::results() const {
                          {"grains", m_.balls.size()},
                          {"height_m", geo_.height0},
                          {"volume_m3", geo_.volume}};
+  spec["center_m"] = geo_.dim == 2
+                         ? nlohmann::json({geo_.center.x(), geo_.center.y()})
+                         : nlohmann::json({geo_.center.x(), geo_.center.y(), geo_.center.z()});
   if (geo_.diametral) {
     spec["diameter_m"] = geo_.width0.x();
     spec["thickness_m"] = geo_.thickness;

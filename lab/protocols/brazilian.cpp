@@ -1,8 +1,12 @@
 // Brazilian (indirect tension) test: a disk between flat platens that keep the specimen's wall
-// friction, loaded across its diameter; the tensile strength is 2F / (pi D t) at the peak. The
-// test ends only when the disk has split: cracks within 0.2 D of the loaded diameter cover
-// stop.split_fraction of it in one unbroken run of tenths, or the load collapses below
-// stop.failed_fraction of its peak without a split (docs/protocol-format.md).
+// friction, loaded across its diameter. The disk has split when cracks within 0.2 D of the
+// loaded diameter cover stop.split_fraction of it in one unbroken run of tenths; the tensile
+// strength is the largest 2F / (pi D t) up to that crack (after it the two halves can carry more
+// load as columns under flat platens, which is not the rock's tensile strength). Without a split
+// there is no tensile strength, only a peak. The test ends once the disk has split and the load
+// fell, or when the load collapses below stop.failed_fraction of its peak without a split
+// (docs/protocol-format.md).
+#include "lab/protocols/brazilian.hpp"
 #include "lab/protocols/frame_test.hpp"
 
 #include "io/json_fields.hpp"
@@ -13,14 +17,47 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 namespace rocklab {
 
 namespace {
 
+// Cracks within 0.2 D of the loaded diameter (the y axis through the centre), binned by their
+// position along it: the split is complete once one unbroken run covers `need` of the ten bins.
+// Crushing under both platens covers the two ends of the diameter but not the middle.
+class SplitBins {
+public:
+  SplitBins(const SpecimenGeometry& g, double fraction)
+      : d_(g.width0.y()), centre_(g.center),
+        need_(static_cast<int>(std::ceil(fraction * 10.0 - 1e-9))) {}
+  /// Bins one crack; true once the run is long enough.
+  bool add(const Crack& c) {
+    const Vec3 rel = c.position - centre_;
+    if (std::abs(rel.x()) <= 0.2 * d_) {
+      const double t = (rel.y() + 0.5 * d_) / d_;
+      bins_[static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor(t * 10.0)), 0, 9))] =
+          true;
+    }
+    int run = 0, longest = 0;
+    for (bool b : bins_) {
+      run = b ? run + 1 : 0;
+      longest = std::max(longest, run);
+    }
+    return longest >= need_;
+  }
+
+private:
+  double d_;
+  Vec3 centre_;
+  int need_;
+  std::array<bool, 10> bins_{};
+};
+
 class BrazilianTest final : public FrameTest {
 public:
   const char* name() const override { return "brazilian"; }
+  int revision() const override { return 2; } // 2: the strength is taken before the split
   FrameSetup setup() const override {
     FrameSetup s;
     s.diametral = true;
@@ -60,13 +97,40 @@ public:
   }
   void results(const LoadingFrame& f, nlohmann::json& r) const override {
     const Protocol& p = f.protocol();
-    if (p.split_fraction > 0)
-      r["split"] = {{"found", split_step_ >= 0},
-                    {"step", split_step_},
-                    {"fraction_required", p.split_fraction}};
-    r["tensile_strength_Pa"] = f.peak().load;
-    r["peak_force_N"] = f.peak().force;
-    r["peak_axial_strain"] = f.peak().strain;
+    const PeakRecord& peak = f.peak();
+    if (p.split_fraction <= 0) { // the split check is off: the peak, as the user asked
+      r["tensile_strength_Pa"] = peak.load;
+      r["tensile_strength_method"] = "the peak of 2F/(pi D t) (stop.split_fraction 0)";
+      r["peak_force_N"] = peak.force;
+      r["peak_axial_strain"] = peak.strain;
+      return;
+    }
+    const std::int64_t split =
+        split_crack_step(f.cracks().cracks(), f.geometry(), p.split_fraction);
+    r["split"] = {{"found", split >= 0},
+                  {"step", split},
+                  {"fraction_required", p.split_fraction},
+                  {"peak_Pa", peak.load}, // the largest 2F/(pi D t) of the whole test
+                  {"peak_step", peak.step}};
+    const LabSample best = strongest_before(f.samples(), peak, split);
+    if (best.load <= 0) { // no split, or one before loading began (seating)
+      r["tensile_strength_Pa"] = nullptr;
+      r["peak_force_N"] = peak.force;
+      r["peak_axial_strain"] = peak.strain;
+      r["warnings"].push_back(
+          std::string(split < 0 ? "the disk did not split along its loaded diameter"
+                                : "the disk split before loading began") +
+          ": the peak of 2F/(pi D t), " + format_double(1e-6 * peak.load) +
+          " MPa, is not a tensile strength (crushing at the platens?); see crack_map.svg");
+      return;
+    }
+    r["tensile_strength_Pa"] = best.load;
+    r["tensile_strength_method"] =
+        "the largest 2F/(pi D t) up to the crack that completed the diametral split";
+    r["tensile_strength_step"] = best.step;
+    r["peak_force_N"] = best.force;
+    r["peak_axial_strain"] = best.axial_strain;
+    r["split"]["stress_Pa"] = best.load;
   }
   PlotLabels plot_labels() const override {
     return {"platen displacement / D [%]", "2F / (pi D t) [MPa]", false, 2};
@@ -75,45 +139,57 @@ public:
   void load(const nlohmann::json& state, const std::string& file) override {
     JsonFieldReader r{state, file};
     r("split_step", split_step_);
-    bins_.fill(false);
+    bins_.reset();
     scanned_ = 0; // rebinned from the restored cracks at the next check
+    split_ = false;
   }
 
 private:
-  // Cracks within 0.2 D of the loaded diameter (the y axis through the centre), binned by their
-  // position along it; a split covers split_fraction of the ten bins without a gap.
+  // Bins the cracks formed since the last check; records the check that first saw the split.
   bool split_seen(const LoadingFrame& f) {
-    const double d = f.geometry().width0.y();
+    if (!bins_)
+      bins_.emplace(f.geometry(), f.protocol().split_fraction);
     const auto& cracks = f.cracks().cracks();
-    for (; scanned_ < cracks.size(); ++scanned_) {
-      const Crack& c = cracks[scanned_];
-      const Vec3 rel = c.position - f.geometry().center;
-      if (std::abs(rel.x()) > 0.2 * d)
-        continue;
-      const double t = (rel.y() + 0.5 * d) / d;
-      const int bin = std::clamp(static_cast<int>(std::floor(t * 10.0)), 0, 9);
-      bins_[static_cast<std::size_t>(bin)] = true;
-    }
-    // The longest unbroken run of cracked tenths: crushing under both platens covers the two
-    // ends of the diameter but not the middle, a split covers it continuously.
-    int run = 0, longest = 0;
-    for (bool b : bins_) {
-      run = b ? run + 1 : 0;
-      longest = std::max(longest, run);
-    }
-    const bool split =
-        longest >= static_cast<int>(std::ceil(f.protocol().split_fraction * 10.0 - 1e-9));
-    if (split && split_step_ < 0)
+    for (; scanned_ < cracks.size(); ++scanned_)
+      split_ = bins_->add(cracks[scanned_]) || split_;
+    if (split_ && split_step_ < 0)
       split_step_ = f.model().step();
-    return split;
+    return split_;
   }
 
-  std::array<bool, 10> bins_{};  ///< which tenths of the loaded diameter hold a crack near it
-  std::size_t scanned_ = 0;      ///< cracks already binned (rebuilt from the cracks on resume)
+  std::optional<SplitBins> bins_; ///< the cracks binned so far (rebuilt on resume)
+  std::size_t scanned_ = 0;       ///< cracks already binned
+  bool split_ = false;
   std::int64_t split_step_ = -1; ///< first stop check (after the drop) that saw the split
 };
 
 } // namespace
+
+std::int64_t split_crack_step(const std::vector<Crack>& cracks, const SpecimenGeometry& g,
+                              double fraction) {
+  SplitBins bins(g, fraction);
+  for (const Crack& c : cracks)
+    if (bins.add(c))
+      return c.step;
+  return -1;
+}
+
+LabSample strongest_before(const std::vector<LabSample>& samples, const PeakRecord& peak,
+                           std::int64_t split) {
+  LabSample best;
+  best.load = -1;
+  if (split < 0)
+    return best;
+  if (peak.step >= 0 && peak.step <= split) {
+    best.step = peak.step, best.time = peak.time, best.axial_strain = peak.strain;
+    best.axial_stress = peak.stress, best.load = peak.load, best.force = peak.force;
+    return best;
+  }
+  for (const LabSample& s : samples)
+    if (s.step <= split && s.load > best.load)
+      best = s;
+  return best;
+}
 
 std::unique_ptr<LabProtocol> make_brazilian_test() {
   return std::make_unique<BrazilianTest>();
