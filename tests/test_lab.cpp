@@ -447,8 +447,14 @@ TEST(Lab, SuiteRunsTestsInParallelAndSummarises) {
   EXPECT_TRUE(p["hoek_brown_mi"].is_null());                    // ... but no Hoek-Brown
   // The UCS test's crack initiation, and every test's warnings gathered under its name.
   const nlohmann::json ucs = read_json_file((out / "tests" / "ucs" / "results.json").string());
+  // The summary's ratio is the strain-based one (the laboratory's), the count onset beside it.
   ASSERT_TRUE(ucs["crack_initiation_stress_Pa"].is_number()) << ucs.dump();
+  ASSERT_TRUE(ucs["crack_initiation_stress_volumetric_Pa"].is_number()) << ucs.dump();
   EXPECT_TRUE(test::near_rel(p["crack_initiation_over_ucs"].get<double>(),
+                             ucs["crack_initiation_stress_volumetric_Pa"].get<double>() /
+                                 ucs["peak_stress_Pa"].get<double>(),
+                             1e-12));
+  EXPECT_TRUE(test::near_rel(p["crack_initiation_count_over_ucs"].get<double>(),
                              ucs["crack_initiation_stress_Pa"].get<double>() /
                                  ucs["peak_stress_Pa"].get<double>(),
                              1e-12));
