@@ -1,6 +1,7 @@
 // Calibration: the stages on a cheap synthetic rock with a known answer (every parameter 2x off,
 // 0.5 % noise, the acceptance tolerances in at most 40 evaluations); the calibration file, good and
 // bad; rocklab calibrate end to end on a tiny specimen, interrupted and resumed from its cache.
+#include "lab/calibration/evaluator.hpp"
 #include "lab/calibration/stages.hpp"
 
 #include "helpers.hpp"
@@ -116,6 +117,21 @@ TEST(Calibration, ScatterInPoissonsRatioDoesNotThrowTheStiffnessRatioAcrossItsRa
   ASSERT_GE(kr.size(), 3u);
   EXPECT_LT(kr[2] / kr[1], 1.3) << kr[0] << " " << kr[1] << " " << kr[2];
   EXPECT_GT(kr[2] / kr[1], 1.0); // still towards the target
+}
+
+TEST(Calibration, ASeedWithoutAMeasurementDoesNotBlankTheEvaluation) {
+  // A Brazilian disk that never split on one seed: its BTS is null there.
+  const std::map<std::string, std::vector<double>> all{
+      {"bts_Pa", {2e7, std::nan(""), 3e7}},
+      {"ucs_Pa", {1e8, 2e8, 3e8}},
+      {"friction_angle_deg", {std::nan(""), std::nan(""), std::nan("")}}};
+  Evaluation ev;
+  const std::vector<std::string> partial = average_replicates(all, ev);
+  EXPECT_DOUBLE_EQ(ev.mean["bts_Pa"], 2.5e7);
+  EXPECT_NEAR(ev.sd["bts_Pa"], std::sqrt(0.5e14), 1e-3);
+  EXPECT_DOUBLE_EQ(ev.mean["ucs_Pa"], 2e8);
+  EXPECT_TRUE(std::isnan(ev.mean["friction_angle_deg"])); // no seed measured it: not measured
+  EXPECT_EQ(partial, std::vector<std::string>{"bts_Pa"});
 }
 
 TEST(Calibration, AnErrorInTheOptimiserStageIsNotSwallowed) {

@@ -153,16 +153,37 @@ Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_
       all[k].push_back(v.is_number() ? v.get<double>() : std::nan(""));
   }
   cached_ += ev.cached;
-  for (const auto& [k, v] : all) {
-    double m = 0, q = 0;
+  for (const std::string& k : average_replicates(all, ev))
+    if (!o_.ranks || o_.ranks->rank() == 0)
+      std::fprintf(stderr,
+                   "[rocklab calibrate] warning: %s was not measured on every seed; the mean is "
+                   "over those that measured it\n",
+                   k.c_str());
+  return ev;
+}
+
+// The mean over the seeds that measured a property: a seed whose test gave none (a Brazilian disk
+// that never split) is left out and said, not allowed to blank the whole evaluation (stage 3 would
+// see a missing target there and the optimiser a huge penalty).
+std::vector<std::string> average_replicates(const std::map<std::string, std::vector<double>>& all,
+                                            Evaluation& ev) {
+  std::vector<std::string> partial;
+  for (const auto& [k, all_v] : all) {
+    std::vector<double> v;
+    for (double x : all_v)
+      if (std::isfinite(x))
+        v.push_back(x);
+    double m = v.empty() ? std::nan("") : 0.0, q = 0;
     for (double x : v)
       m += x / static_cast<double>(v.size());
     for (double x : v)
       q += (x - m) * (x - m);
     ev.mean[k] = m;
     ev.sd[k] = v.size() > 1 ? std::sqrt(q / static_cast<double>(v.size() - 1)) : 0.0;
+    if (!v.empty() && v.size() < all_v.size())
+      partial.push_back(k);
   }
-  return ev;
+  return partial;
 }
 
 } // namespace rocklab::calibration

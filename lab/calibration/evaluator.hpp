@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <string>
 
 namespace rocklab::calibration {
@@ -29,6 +30,12 @@ struct Evaluation {
   std::vector<std::string> folders; ///< the suites' output folders, one per seed
   int cached = 0;                   ///< seeds found in the cache
 };
+
+/// Adds to `ev` the mean and sample standard deviation of each property over the seeds that
+/// measured it (non-finite values are left out; NaN when none did); returns the properties some
+/// seeds did not measure.
+std::vector<std::string> average_replicates(const std::map<std::string, std::vector<double>>& all,
+                                            Evaluation& ev);
 
 class Evaluator {
 public:
