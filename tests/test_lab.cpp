@@ -299,16 +299,15 @@ TEST(Lab, BrazilianAndDirectTension) {
   const std::int64_t split = b["split"]["step"].get<std::int64_t>();
   const double d = b["specimen"]["diameter_m"].get<double>();
   std::array<bool, 10> bins{};
-  auto longest = [&] { // the span of cracked tenths joined by at most single empty ones
-    int best = 0, start = -1, gap = 0;
-    for (int i = 0; i < 10; ++i) {
-      if (bins[static_cast<std::size_t>(i)]) {
-        start = start < 0 || gap > 1 ? i : start, gap = 0;
-        best = std::max(best, i - start + 1);
-      } else {
-        ++gap;
+  auto longest = [&] { // the longest span between cracked tenths with at most one empty inside
+    int best = 0;
+    for (int a = 0; a < 10; ++a)
+      for (int b = a, empty = 0; b < 10 && empty <= 1; ++b) {
+        if (!bins[static_cast<std::size_t>(b)])
+          ++empty;
+        else if (bins[static_cast<std::size_t>(a)])
+          best = std::max(best, b - a + 1);
       }
-    }
     return best;
   };
   const auto cracks = read_csv(bz_out / "cracks.csv");
@@ -364,11 +363,20 @@ TEST(Lab, BrazilianStrengthIsTheLoadBeforeTheSplitNotTheHalvesLoadedAfterIt) {
   crack(320, 0.0035, -0.005);                     // tenth 2: tenths 3 and 4 still empty
   crack(330, -0.002, 0.007);                      // tenth 8: 5-9 one run of five
   crack(335, 0.008, -0.003);                      // tenth 3 but 8 mm off the diameter
-  crack(340, 0, -0.003);                          // tenth 3: 0 to 9 joined by single bridges
-  crack(350, 0, -0.001);                          // tenth 4
+  crack(340, 0, -0.003);                          // tenth 3: 2-6 with one bridge, five
+  crack(350, 0, -0.001);                          // tenth 4: 2-9 bridging tenth 7
   EXPECT_EQ(split_crack_step(cracks, g, 0.5), 330);
-  EXPECT_EQ(split_crack_step(cracks, g, 0.6), 340); // single empty tenths (1, 4, 7) are bridged
-  EXPECT_EQ(split_crack_step(cracks, g, 1.0), 340);
+  EXPECT_EQ(split_crack_step(cracks, g, 0.6), 350);
+  EXPECT_EQ(split_crack_step(cracks, g, 0.8), 350);
+  EXPECT_EQ(split_crack_step(cracks, g, 0.9), -1); // 0-9 would need two bridges (tenths 1, 7)
+  std::vector<Crack> diffuse; // every other tenth: scattered damage, not a split
+  for (int t : {1, 3, 5, 7, 9}) {
+    diffuse.push_back(cracks[0]);
+    diffuse.back().step = 100 + t;
+    diffuse.back().position = g.center + Vec3(0, 0.002 * t - 0.009, 0);
+  }
+  EXPECT_EQ(split_crack_step(diffuse, g, 0.3), 103); // tenths 1-3 with one bridge
+  EXPECT_EQ(split_crack_step(diffuse, g, 0.4), -1);
   EXPECT_EQ(split_crack_step({cracks.begin(), cracks.begin() + 2}, g, 0.2), -1); // ends only
   EXPECT_EQ(split_crack_step({cracks.begin(), cracks.begin() + 6}, g, 0.6), -1); // 3-4 empty
   // The load climbs to 20 MPa, the disk splits at step 350, the halves then carry 30 MPa.
