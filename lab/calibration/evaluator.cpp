@@ -95,22 +95,23 @@ void Evaluator::check_tests(const nlohmann::json& summary, const fs::path& suite
 
 Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_t seeds) {
   const nlohmann::json card = apply_params(c_.material, c_.params, values);
+  const nlohmann::json stage_tests = tests_of(s);
+  // The cache key: everything the result depends on, with the revision of each test's measurement
+  // rules where it was raised (older keys stay valid for the other tests).
+  std::string revisions;
+  for (const auto& t : stage_tests)
+    if (const auto p = make_lab_protocol(t.value("test", "")); p && p->revision() > 1) {
+      revisions += '|';
+      revisions += p->name();
+      revisions += " r" + std::to_string(p->revision());
+    }
   std::vector<Replicate> reps;
   for (std::uint64_t seed : c_.seeds) {
     if (reps.size() >= seeds)
       break;
-    nlohmann::json ts = tests_of(s);
+    nlohmann::json ts = stage_tests;
     for (auto& t : ts)
       t["seed"] = seed;
-    // The cache key: everything the result depends on, with the revision of each test's
-    // measurement rules where it was raised (older keys stay valid for the other tests).
-    std::string revisions;
-    for (const auto& t : ts)
-      if (const auto p = make_lab_protocol(t.value("test", "")); p && p->revision() > 1) {
-        revisions += '|';
-        revisions += p->name();
-        revisions += " r" + std::to_string(p->revision());
-      }
     const std::string key =
         text_hash(card.dump() + "|" + ts.dump() + "|" + ROCKLAB_VERSION + revisions).substr(0, 16);
     reps.push_back({fs::path(o_.out_dir) / "evaluations" / key, ts});

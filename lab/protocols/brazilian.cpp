@@ -1,16 +1,15 @@
 // Brazilian (indirect tension) test: a disk between flat platens that keep the specimen's wall
 // friction, loaded across its diameter. The disk has split when cracks within 0.2 D of the
 // loaded diameter cover stop.split_fraction of it in one run of tenths (bridging at most one
-// empty tenth); the tensile
-// strength is the largest 2F / (pi D t) up to that crack (after it the two halves can carry more
-// load as columns under flat platens, which is not the rock's tensile strength). Without a split
+// empty tenth); the tensile strength is the largest 2F / (pi D t) up to that crack (after it the
+// two halves can carry more load as columns under flat platens, which is not the rock's tensile
+// strength). Without a split
 // there is no tensile strength, only a peak. The test ends once the disk has split and the load
 // fell, or when the load collapses below stop.failed_fraction of its peak without a split
 // (docs/protocol-format.md).
 #include "lab/protocols/brazilian.hpp"
 #include "lab/protocols/frame_test.hpp"
 
-#include "io/json_fields.hpp"
 #include "io/json_input.hpp"
 #include "io/results.hpp"
 
@@ -155,32 +154,26 @@ public:
   PlotLabels plot_labels() const override {
     return {"platen displacement / D [%]", "2F / (pi D t) [MPa]", false, 2};
   }
-  void save(nlohmann::json& state) const override { state["split_step"] = split_step_; }
-  void load(const nlohmann::json& state, const std::string& file) override {
-    JsonFieldReader r{state, file};
-    r("split_step", split_step_);
+  void load(const nlohmann::json& /*state*/, const std::string& /*file*/) override {
     bins_.reset();
     scanned_ = 0; // rebinned from the restored cracks at the next check
     split_ = false;
   }
 
 private:
-  // Bins the cracks formed since the last check; records the check that first saw the split.
+  // Bins the cracks formed since the last check (results() finds the split's crack itself).
   bool split_seen(const LoadingFrame& f) {
     if (!bins_)
       bins_.emplace(f.geometry(), f.protocol().split_fraction);
     const auto& cracks = f.cracks().cracks();
     for (; scanned_ < cracks.size(); ++scanned_)
       split_ = bins_->add(cracks[scanned_]) || split_;
-    if (split_ && split_step_ < 0)
-      split_step_ = f.model().step();
     return split_;
   }
 
   std::optional<SplitBins> bins_; ///< the cracks binned so far (rebuilt on resume)
   std::size_t scanned_ = 0;       ///< cracks already binned
-  bool split_ = false;
-  std::int64_t split_step_ = -1; ///< first stop check (after the drop) that saw the split
+  bool split_ = false;            ///< the binned cracks make a split
 };
 
 } // namespace

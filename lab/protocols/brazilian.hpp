@@ -11,7 +11,8 @@
 namespace rocklab {
 
 /// The step of the crack that completed the diametral split (cracks within 0.2 D of the loaded
-/// diameter covering `fraction` of its ten bins in one unbroken run), or -1 without a split.
+/// diameter spanning `fraction` of its ten bins in one run that bridges at most one empty bin),
+/// or -1 without a split.
 std::int64_t split_crack_step(const std::vector<Crack>& cracks, const SpecimenGeometry& g,
                               double fraction);
 
