@@ -4,6 +4,8 @@
 #include "io/specimen.hpp"
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace fs = std::filesystem;
 using namespace rocklab;
@@ -115,4 +117,40 @@ TEST(Specimen, BadFilesFailCleanly) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("key 'version'"), std::string::npos) << e.what();
   }
+}
+
+// results.json is streamed item by item (a 10k-sphere flat-jointed model's list was ~1.5 GB as a
+// document in memory): the stream is the document's own dump(1) text plus the contact count, and
+// the per-contact list is opt-in above kContactsAutoLimit contacts or when a scene says so.
+TEST(Specimen, ResultsAreStreamedAsTheDocumentAndLargeContactListsAreOptIn) {
+  std::unique_ptr<Model> m = busy_model();
+  m->cycle(50);
+  ASSERT_GT(m->contacts().size(), 10u);
+  nlohmann::json doc = results_json(*m, {}, "x");
+  doc["contact_count"] = m->contacts().size();
+  std::ostringstream full;
+  write_results_json(full, *m, {}, "x", ContactOutputMode::Auto);
+  EXPECT_EQ(full.str(), doc.dump(1) + "\n");
+  std::ostringstream none;
+  write_results_json(none, *m, {}, "x", ContactOutputMode::Never);
+  const nlohmann::json n = nlohmann::json::parse(none.str());
+  EXPECT_FALSE(n.contains("contacts"));
+  EXPECT_TRUE(n["contacts_omitted"].is_string());
+  EXPECT_EQ(n["balls"], doc["balls"]);
+  EXPECT_TRUE(contacts_written(ContactOutputMode::Auto, kContactsAutoLimit));
+  EXPECT_FALSE(contacts_written(ContactOutputMode::Auto, kContactsAutoLimit + 1));
+  EXPECT_TRUE(contacts_written(ContactOutputMode::Always, kContactsAutoLimit + 1));
+  // The scene key.
+  nlohmann::json scene = nlohmann::json::parse(
+      std::ifstream(test::source_dir() + "/examples/two_ball_collision.json"));
+  const std::string path = (test::scratch_root() / "output_contacts.json").string();
+  for (const bool want : {true, false}) {
+    scene["output"] = {{"contacts", want}};
+    std::ofstream(path) << scene.dump();
+    EXPECT_EQ(load_scene(path).contacts_output,
+              want ? ContactOutputMode::Always : ContactOutputMode::Never);
+  }
+  scene["output"] = {{"contacts", "yes"}};
+  std::ofstream(path) << scene.dump();
+  EXPECT_THROW(load_scene(path), InputError);
 }

@@ -6,11 +6,23 @@
 
 #include <nlohmann/json.hpp>
 
+#include <iosfwd>
+
 namespace rocklab {
 
 /// Final state: balls, walls, contacts (global and contact-plane force and moment), energies.
 nlohmann::json results_json(const Model& m, const EventCounts& counts,
                             const std::string& scene_file);
+
+/// Contacts listed in results.json by default (ContactOutputMode::Auto, scene.hpp).
+inline constexpr std::size_t kContactsAutoLimit = 20000;
+bool contacts_written(ContactOutputMode mode, std::size_t contacts);
+
+/// results.json written as a stream (the ball and contact lists one item at a time, never the
+/// whole document in memory); the text of results_json(...).dump(1) plus `contact_count` and,
+/// when the list is left out, `contacts_omitted` saying why.
+void write_results_json(std::ostream& os, const Model& m, const EventCounts& counts,
+                        const std::string& scene_file, ContactOutputMode mode);
 
 /// Energies as a JSON object (joules).
 nlohmann::json energy_json(const EnergyLedger& e);

@@ -235,6 +235,13 @@ Scene load_scene(const std::string& path) {
     s.stages.push_back(st);
   }
   read_history(top, s);
+  if (top.has("output")) {
+    JsonObject o = top.object("output");
+    if (o.has("contacts"))
+      s.contacts_output =
+          o.boolean("contacts") ? ContactOutputMode::Always : ContactOutputMode::Never;
+    o.finish();
+  }
   top.finish();
   return s;
 }

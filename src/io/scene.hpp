@@ -67,6 +67,10 @@ struct Stage {
   std::vector<MethodCall> methods;
 };
 
+/// Whether results.json lists every contact: `Auto` up to kContactsAutoLimit (results.hpp)
+/// contacts (a larger model's list is hundreds of MB), or always / never (`output.contacts`).
+enum class ContactOutputMode { Auto, Always, Never };
+
 struct Scene {
   std::string file;
   std::string description;
@@ -74,6 +78,7 @@ struct Scene {
   std::vector<Stage> stages;
   std::int64_t history_every = 0;
   std::vector<HistoryColumn> history;
+  ContactOutputMode contacts_output = ContactOutputMode::Auto;
 };
 
 /// Load and validate a scene file. Throws InputError naming the file, key, value and range.
