@@ -99,11 +99,15 @@ GenesisResult run_genesis(const MaterialCard& card,
   m.settings.gravity = Vec3::Zero();
   m.settings.slip_events = false; // nobody reads them during genesis
   genesis::Run run(card, m, rep, progress, interrupt);
-  genesis::place_grains(run);
-  genesis::relax_cloud(run);
-  genesis::remove_escaped(run);
-  genesis::compact(run);
-  genesis::remove_escaped(run);
+  if (card.packing_import.empty()) {
+    genesis::place_grains(run);
+    genesis::relax_cloud(run);
+    genesis::remove_escaped(run);
+    genesis::compact(run);
+    genesis::remove_escaped(run);
+  } else {
+    genesis::import_grains(run);
+  }
   genesis::remove_floaters(run);
   genesis::join_clumps(run);
   genesis::finalize_contacts(run);

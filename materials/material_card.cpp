@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <sstream>
@@ -204,6 +205,17 @@ void read_packing(JsonObject& top, MaterialCard& c) {
   c.equilibrium_ratio = p.number("equilibrium_ratio", Range::positive(), 5e-3);
   c.max_cycles = p.integer("max_cycles", 1000, std::numeric_limits<std::int64_t>::max(), 2'000'000);
   c.eliminate_floaters = p.boolean("eliminate_floaters", false);
+  if (p.has("import")) {
+    const std::filesystem::path f = p.string("import");
+    c.packing_import =
+        (f.is_absolute() ? f : std::filesystem::path(c.file).parent_path() / f).string();
+    if (!std::filesystem::is_regular_file(c.packing_import))
+      p.fail("import", "no such packing file: " + c.packing_import);
+    std::ifstream in(c.packing_import, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    c.text_hash = text_hash(c.text_hash + text_hash(ss.str())); // the packing is input too
+  }
   p.finish();
 }
 
@@ -213,10 +225,10 @@ void read_installation(JsonObject& top, MaterialCard& c) {
   c.pressure_tolerance = i.number("pressure_tolerance", {0, 1, true, true}, 0.02);
   if (i.has("gap") && i.has("gap_ratio"))
     i.fail("gap", "give either 'gap' (m) or 'gap_ratio' (g_i / R_avg), not both");
-  if (i.has("gap_ratio"))
-    c.install_gap =
-        i.number("gap_ratio", Range::non_negative(), std::nullopt) * 0.5 * (c.r_min + c.r_max);
-  else
+  if (i.has("gap_ratio")) {
+    c.install_gap_ratio = i.number("gap_ratio", Range::non_negative(), std::nullopt);
+    c.install_gap = c.install_gap_ratio * 0.5 * (c.r_min + c.r_max);
+  } else
     c.install_gap = i.number("gap", Range::non_negative(), 0.0, "m");
   c.residual_tolerance = i.number("residual_tolerance", Range::positive(), 0.05);
   i.finish();
@@ -336,6 +348,9 @@ MaterialCard load_material_card(const std::string& path) {
   }
   read_packing(top, c);
   read_installation(top, c);
+  if (!c.packing_import.empty() && c.clump_max > 0)
+    top.fail("clumps", "clumped grains are made by packing; they cannot be combined with an "
+                       "imported packing ('packing.import')");
   c.linear = read_linear(top.object("linear"));
   read_bonding(top, c);
   read_joints(top, c, path);

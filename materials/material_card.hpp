@@ -74,6 +74,10 @@ struct MaterialCard {
   // release
   double residual_tolerance = 0.05; ///< mean residual stress / pressure after release
   bool eliminate_floaters = false;
+  /// `packing.import`: the grains come from this text file (resolved path; "x y z r" or in 2D
+  /// "x y r" per line) instead of being packed in a vessel; empty: packed.
+  std::string packing_import;
+  double install_gap_ratio = -1; ///< `installation.gap_ratio` when given (else -1)
   /// > 1: before bonding, touching grains are joined into rigid clumps of up to this many
   /// pebbles (rock-impact thesis Appendix B); 0: single grains.
   int clump_max = 0;

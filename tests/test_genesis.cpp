@@ -333,3 +333,72 @@ TEST(Genesis, ClumpedContactBondedSpecimen) {
     EXPECT_EQ(back->clumps[k].q.coeffs(), m.clumps[k].q.coeffs());
   }
 }
+
+// An imported packing (another code's specimen, "x y r" per line) is finalized like a packed one:
+// the same grains (moved to centre their bounding box), bonds at the pairs within the installation
+// gap, the card's shape type at the packing's extent; bad lines name the file and the line.
+TEST(Genesis, ImportedPackingIsFinalizedLikeAPackedOne) {
+  const MaterialCard c = load_material_card(card("genesis_2d_rect.json"));
+  const GenesisResult g = run_genesis(c);
+  const Model& a = *g.model;
+  const fs::path pack = rocklab::test::scratch_root() / "packing-2d.txt";
+  {
+    std::ofstream f(pack);
+    f.precision(17);
+    f << "# x y r (m), shifted by (1, 2) m\n\n";
+    for (std::size_t i = 0; i < a.balls.size(); ++i)
+      f << a.balls.pos[i].x() + 1 << ' ' << a.balls.pos[i].y() + 2 << ' ' << a.balls.radius[i]
+        << '\n';
+  }
+  std::int64_t within = 0;
+  for (const Contact& k : a.contacts())
+    within += k.kind == ContactKind::BallBall && k.gap <= c.install_gap;
+  const MaterialCard ci = load_material_card(
+      edited_card("genesis_2d_rect.json", "\"installation\":",
+                  "\"packing\": {\"import\": \"" + pack.string() + "\"},\n  \"installation\":"));
+  const GenesisResult h = run_genesis(ci);
+  const Model& b = *h.model;
+  ASSERT_EQ(b.balls.size(), a.balls.size());
+  Vec3 lo = Vec3::Constant(1e300), hi = -lo;
+  for (std::size_t i = 0; i < a.balls.size(); ++i) {
+    lo = lo.cwiseMin(a.balls.pos[i] - Vec3::Constant(a.balls.radius[i]));
+    hi = hi.cwiseMax(a.balls.pos[i] + Vec3::Constant(a.balls.radius[i]));
+  }
+  const double r_avg = 0.5 * (0.001 + 0.0015);
+  double sum_a = 0, sum_b = 0, worst = 0;
+  for (std::size_t i = 0; i < a.balls.size(); ++i) {
+    sum_a += a.balls.radius[i];
+    sum_b += b.balls.radius[i];
+  }
+  EXPECT_TRUE(near_rel(sum_b, sum_a, 1e-12));
+  // Every imported grain sits where its original did (up to the centring shift and the release).
+  for (std::size_t j = 0; j < b.balls.size(); ++j) {
+    double best = 1e300;
+    for (std::size_t i = 0; i < a.balls.size(); ++i)
+      if (a.balls.radius[i] == b.balls.radius[j]) {
+        Vec3 d = a.balls.pos[i] - 0.5 * (lo + hi) - b.balls.pos[j];
+        d.z() = 0;
+        best = std::min(best, d.norm());
+      }
+    worst = std::max(worst, best);
+  }
+  EXPECT_LT(worst, 0.05 * r_avg);
+  const GenesisReport& r = h.report;
+  EXPECT_NEAR(static_cast<double>(r.fj_bonded + r.fj_gapped + r.fj_slit),
+              static_cast<double>(within), 1.0);
+  EXPECT_GT(r.fj_bonded, 0);
+  EXPECT_EQ(r.shape.shape, SpecimenShape::Rectangle);
+  EXPECT_TRUE(near_rel(r.shape.size.x(), hi.x() - lo.x(), 1e-9));
+  EXPECT_TRUE(near_rel(r.shape.size.y(), hi.y() - lo.y(), 1e-9));
+  // Bad packings.
+  std::ofstream(pack) << "0 0 0.001\n0.01 0.02\n";
+  try {
+    run_genesis(ci);
+    ADD_FAILURE() << "a short line was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(pack.string()), std::string::npos) << e.what();
+  }
+  fs::remove(pack);
+  EXPECT_THROW(load_material_card(ci.file), InputError);
+}

@@ -16,11 +16,11 @@ void finalize_contacts(Run& g) {
   const double r_avg = g.r_avg;
   // Finalization: bonds at grain-grain contacts with gap <= g_i, linear elsewhere.
   g.say("finalizing");
-  m.set_margin(std::max(m.margin(), card.install_gap * 1.01));
+  m.set_margin(std::max(m.margin(), g.install_gap * 1.01));
   std::vector<std::size_t> candidates;
   for (std::size_t ci = 0; ci < m.contacts().size(); ++ci) {
     const Contact& c = m.contacts()[ci];
-    if (c.kind == ContactKind::BallBall && c.gap <= card.install_gap)
+    if (c.kind == ContactKind::BallBall && c.gap <= g.install_gap)
       candidates.push_back(ci);
   }
   for (std::size_t i = candidates.size(); i > 1; --i) // seeded Fisher-Yates shuffle

@@ -62,7 +62,8 @@ Vessel make_vessel(Model& m, const MaterialCard& card, double scale);
 struct Run {
   Run(const MaterialCard& c, Model& model, GenesisReport& r,
       const std::function<void(const std::string&)>& p, const std::atomic<bool>* i)
-      : card(c), m(model), rep(r), progress(p), interrupt(i), rng(c.seed) {}
+      : card(c), m(model), rep(r), progress(p), interrupt(i), rng(c.seed),
+        install_gap(c.install_gap) {}
 
   const MaterialCard& card;
   Model& m;
@@ -81,6 +82,7 @@ struct Run {
   double largest_half = 0;     ///< largest wall distance from the centre when compaction began [m]
   double installed_volume = 0; ///< vessel volume at the end of installation [m^3]
   std::vector<double> k_sums;  ///< the servo's per-wall stiffness sums (reused)
+  double install_gap;          ///< g_i [m]: the card's, or its ratio times an imported mean radius
 
   void say(const std::string& s) const {
     if (progress)
@@ -113,8 +115,15 @@ struct Run {
   double porosity_now() const;
 };
 
+/// The order that numbers grains along a Morton (Z-order) curve of cells of size `cell` counted
+/// from `lo` (cloud.cpp): grains near each other in space end up near each other in memory.
+std::vector<std::size_t> morton_order(const std::vector<Vec3>& x, int dim, double cell,
+                                      const Vec3& lo);
+
 // The stages, in order (the file that holds each).
-void place_grains(Run& g);    ///< cloud.cpp: radii, a cloud in the enlarged vessel, Morton order
+void place_grains(Run& g); ///< cloud.cpp: radii, a cloud in the enlarged vessel, Morton order
+/// import.cpp: instead of the three above, grains read from the card's `packing.import`
+void import_grains(Run& g);
 void relax_cloud(Run& g);     ///< packing.cpp: soft packing springs, the cloud relaxed
 void compact(Run& g);         ///< compaction.cpp: to the porosity at the pressure, installed
 void remove_floaters(Run& g); ///< floaters.cpp: count floaters, coordination; remove if asked
