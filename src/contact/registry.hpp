@@ -139,6 +139,27 @@ struct ModelBatches {
   void clear() {
     std::apply([](auto&... b) { ((b.contacts.clear(), b.pool.clear()), ...); }, all);
   }
+  /// Capacity for the contents of `other` and 1/16 more: the list rebuilt at each detection is
+  /// copied into these arrays, which grew by doubling without it (a 10k-grain flat-jointed
+  /// specimen's set-up peaked at 55 MB in them against 22 MB of contact data).
+  void reserve_like(const ModelBatches& other) {
+    auto grow = [](auto& v, std::size_t n) {
+      if (v.capacity() < n)
+        v.reserve(n + n / 16 + 64);
+    };
+    std::apply(
+        [&](auto&... b) {
+          (
+              [&](auto& mine) {
+                const auto& theirs = std::get<std::decay_t<decltype(mine)>>(other.all);
+                grow(mine.contacts, theirs.contacts.size());
+                if constexpr (requires { mine.pool.all; })
+                  grow(mine.pool.all, theirs.pool.all.size());
+              }(b),
+              ...);
+        },
+        all);
+  }
 };
 
 /// Call f(contact) or, for a model with a pool, f(contact, the contact's part of the pool).

@@ -163,6 +163,14 @@ void Model::gather_candidates(const CellGrid& g) {
     candidate_keys_.insert(candidate_keys_.end(), keys.begin(), keys.end());
 }
 
+void Model::reserve_lists() {
+  const std::size_t n = contacts_.size();
+  if (new_contacts_.capacity() < n) {
+    new_contacts_.reserve(n + n / 16 + 64);
+    new_outputs_.reserve(n + n / 16 + 64);
+  }
+}
+
 void Model::merge_candidates() {
   // Merge the candidates with the existing contacts (both sorted by key) into fresh arrays.
   assert(std::adjacent_find(candidate_keys_.begin(), candidate_keys_.end(),
@@ -175,6 +183,8 @@ void Model::merge_candidates() {
   new_contacts_.clear();
   new_outputs_.clear();
   new_batches_.clear();
+  new_batches_.reserve_like(batches_);
+  reserve_lists();
   std::size_t a = 0, b = 0;
   auto keep = [&](std::size_t ci) {
     Contact c = contacts_[ci];

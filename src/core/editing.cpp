@@ -142,6 +142,8 @@ void Model::compact_contacts(const std::function<bool(Contact&)>& keep) {
   new_contacts_.clear();
   new_outputs_.clear();
   new_batches_.clear();
+  new_batches_.reserve_like(batches_);
+  reserve_lists();
   for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
     Contact c = contacts_[ci];
     if (!keep(c)) {

@@ -164,6 +164,8 @@ private:
   // Scratch storage reused between detections (no allocation in the steady cycle).
   std::vector<Contact> new_contacts_;
   std::vector<ContactOutput> new_outputs_;
+  /// Capacity of the rebuilt lists for today's contacts and 1/16 more (no growth by doubling).
+  void reserve_lists();
   ModelBatches new_batches_;
   std::vector<std::uint64_t> candidate_keys_;
   std::vector<std::vector<std::uint64_t>> thread_keys_;
