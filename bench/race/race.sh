@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# The same-specimen race with YADE (issue 15). Usage: bench/race/race.sh [RADIUS_m] [YADE_STEPS]
+# YADE (Debian package `yade`) makes a dense packing of a 16 mm x 32 mm cylinder (default mean
+# radius 0.41 mm: about 10k spheres); rocklab imports exactly that packing (`packing.import`) with
+# 8-element flat joints and with parallel bonds, bonding the pairs YADE's JCFpm bonds (gap within
+# 0.1 (R1 + R2): interaction factor 1.1); both run the elastic window of a UCS at 1 and 2 threads.
+# Prints contact-steps per second of each and the ratios to YADE. Units SI. Run on a quiet machine.
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$here/../.."
+radius="${1:-0.00041}"
+steps="${2:-2000}"
+out="${RACE_OUT:-/tmp/rocklab-race}"
+command -v yade > /dev/null || { echo "race.sh: yade is not installed (apt-get install yade)" >&2; exit 1; }
+rocklab="$root/build/rocklab"
+[ -x "$rocklab" ] || { echo "race.sh: build rocklab first ($rocklab)" >&2; exit 1; }
+mkdir -p "$out"
+cd "$out"
+echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
+yade -n -x "$here/yade_packing.py" packing.txt "$radius" 2>&1 | grep '^spheres'
+for model in fj pb; do
+  cp "$here/race_$model.json" "card_$model.json"
+  rm -f "spec_$model.rlspec"
+  "$rocklab" genesis "card_$model.json" -o "spec_$model.rlspec" -q
+  sed "s#SPECIMEN#$out/spec_$model.rlspec#" "$here/race_ucs.json" > "ucs_$model.json"
+  for t in 1 2; do
+    rm -rf "ucs_${model}_$t"
+    "$rocklab" test "ucs_$model.json" -o "ucs_${model}_$t" --threads "$t" -q > /dev/null
+  done
+done
+for t in 1 2; do
+  yade -n -j "$t" -x "$here/yade_ucs.py" packing.txt "$steps" 2>&1 | grep '^RACE' > "yade_$t.txt"
+done
+python3 - "$out" <<'PY'
+import json, sys
+out = sys.argv[1]
+def yade(t):
+    w = open(f"{out}/yade_{t}.txt").read().split()
+    return int(w[3]) * int(w[7]) / float(w[9])
+def rocklab(model, t):
+    rep = json.load(open(f"{out}/spec_{model}.rlspec.report.json"))
+    p = json.load(open(f"{out}/ucs_{model}_{t}/results.json"))["provenance"]
+    return rep["contacts"]["total"] * p["steps"] / p["wall_time_s"], rep["contacts"]["total"], p["steps"]
+y = {t: yade(t) for t in (1, 2)}
+print(f"YADE JCFpm: {y[1]/1e6:.2f} M contact-steps/s (1 thread), {y[2]/1e6:.2f} M (2 threads)")
+print("| engine / model | contacts | steps | 1 thread M/s | x YADE | 2 threads M/s | x YADE | 2nd thread |")
+print("|---|---|---|---|---|---|---|---|")
+for model, name in (("pb", "rocklab parallel bond"), ("fj", "rocklab flat joint, 8 elements")):
+    r1, n, s = rocklab(model, 1)
+    r2, _, _ = rocklab(model, 2)
+    print(f"| {name} | {n} | {s} | {r1/1e6:.2f} | {r1/y[1]:.2f} | {r2/1e6:.2f} | {r2/y[2]:.2f} | {r2/r1:.2f} |")
+PY
