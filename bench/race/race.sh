@@ -17,11 +17,18 @@ rocklab="$root/build/rocklab"
 mkdir -p "$out"
 cd "$out"
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs)"
-yade -n -x "$here/yade_packing.py" packing.txt "$radius" 2>&1 | grep '^spheres'
+# The packing and the specimens are kept in OUT and reused while the radius and cards are the same.
+if [ "$(cat radius 2> /dev/null)" != "$radius" ] || [ ! -s packing.txt ]; then
+  yade -n -x "$here/yade_packing.py" packing.txt "$radius" 2>&1 | grep '^spheres'
+  echo "$radius" > radius
+fi
 for model in fj pb; do
-  cp "$here/race_$model.json" "card_$model.json"
-  rm -f "spec_$model.rlspec"
-  "$rocklab" genesis "card_$model.json" -o "spec_$model.rlspec" -q
+  if ! cmp -s "$here/race_$model.json" "card_$model.json" || [ ! -s "spec_$model.rlspec" ] ||
+    [ packing.txt -nt "spec_$model.rlspec" ]; then
+    cp "$here/race_$model.json" "card_$model.json"
+    rm -f "spec_$model.rlspec"
+    "$rocklab" genesis "card_$model.json" -o "spec_$model.rlspec" -q
+  fi
   sed "s#SPECIMEN#$out/spec_$model.rlspec#" "$here/race_ucs.json" > "ucs_$model.json"
   for t in 1 2; do
     rm -rf "ucs_${model}_$t"

@@ -5,7 +5,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <stdexcept>
 
 namespace rocklab {
@@ -92,16 +91,8 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
   if (want_history && m.step() % scene.history_every != 0)
     history += history_row(m, scene.history, summary.events);
 
-  {
-    const std::filesystem::path path = out.staged("results.json");
-    std::ofstream os(path, std::ios::binary);
-    if (!os)
-      throw std::runtime_error(path.string() + ": cannot open for writing");
-    write_results_json(os, m, summary.events, scene.file, scene.contacts_output);
-    os.close();
-    if (!os)
-      throw std::runtime_error(path.string() + ": write failed (disk full?)");
-  }
+  write_results_file(out.staged("results.json"), m, summary.events, scene.file,
+                     scene.contacts_output);
   if (want_history)
     write_text_file(out.staged("history.csv"), history);
   else
