@@ -231,6 +231,7 @@ void read_installation(JsonObject& top, MaterialCard& c) {
   } else
     c.install_gap = i.number("gap", Range::non_negative(), 0.0, "m");
   c.residual_tolerance = i.number("residual_tolerance", Range::positive(), 0.05);
+  c.per_contact_draws = i.choice("draws", {"sequence", "per_contact"}, "sequence") == "per_contact";
   i.finish();
 }
 

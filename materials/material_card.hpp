@@ -61,6 +61,10 @@ struct MaterialCard {
   double pressure = 1e5; ///< material-genesis (installation) pressure [Pa]
   double pressure_tolerance = 0.02;
   double install_gap = 0; ///< g_i [m]
+  /// `installation.draws`: "per_contact" draws each bonded contact's type and strengths from its
+  /// own key (common random numbers: a small parameter step changes few contacts, which a
+  /// calibration needs); "sequence" (default) from one stream in shuffled contact order.
+  bool per_contact_draws = false;
   // contacts
   LinearProps linear; ///< grain-wall, non-bonded and new contacts
   enum class Bonding { FlatJoint, ParallelBond, ContactBond, None } bonding = Bonding::FlatJoint;

@@ -7,6 +7,7 @@
 #include "materials/genesis/stages.hpp"
 
 #include <filesystem>
+#include <map>
 #include <numbers>
 
 namespace fs = std::filesystem;
@@ -401,4 +402,54 @@ TEST(Genesis, ImportedPackingIsFinalizedLikeAPackedOne) {
   }
   fs::remove(pack);
   EXPECT_THROW(load_material_card(ci.file), InputError);
+}
+
+// Common random numbers (installation.draws "per_contact"): each bonded contact's type and
+// strengths come from its own key, so a larger installation gap adds bonds and leaves those of the
+// contacts bonded before as they were; the default stream (shuffled in contact order) re-draws
+// nearly all of them when the candidate list changes.
+TEST(Genesis, PerContactDrawsKeepEveryContactWhenTheGapRatioMoves) {
+  auto make = [](bool per_contact, const char* gap) {
+    std::string text = test::read_file(card("genesis_2d_rect.json"));
+    const std::string from = "\"gap_ratio\": 0.05}";
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos);
+    text.replace(at, from.size(),
+                 std::string("\"gap_ratio\": ") + gap +
+                     (per_contact ? ", \"draws\": \"per_contact\"}" : "}"));
+    const fs::path p = rocklab::test::scratch_root() / "draws-card.json";
+    std::ofstream(p) << text;
+    return run_genesis(load_material_card(p.string()));
+  };
+  using State = std::map<std::uint64_t, std::pair<double, int>>;
+  auto states = [](const GenesisResult& g) {
+    State s;
+    const auto& batch = g.model->batches().of<FlatJoint>().contacts;
+    for (const Contact& c : g.model->contacts())
+      if (c.model == model_kind<FlatJoint>)
+        s[c.key] = {batch[c.slot].ten, batch[c.slot].mtype};
+    return s;
+  };
+  auto kept = [](const State& a, const State& b, std::size_t& common) {
+    std::size_t same = 0;
+    common = 0;
+    for (const auto& [key, v] : a)
+      if (const auto it = b.find(key); it != b.end()) {
+        ++common;
+        same += it->second == v;
+      }
+    return same;
+  };
+  // Both gaps below the packing's own margin (0.05 R): the same packing, more candidates.
+  std::size_t common = 0;
+  const State a = states(make(true, "0.03")), b = states(make(true, "0.04"));
+  ASSERT_GT(b.size(), a.size());
+  EXPECT_EQ(kept(a, b, common), common);
+  EXPECT_GT(common, 200u);
+  const std::size_t same = kept(states(make(false, "0.03")), states(make(false, "0.04")), common);
+  EXPECT_LT(static_cast<double>(same), 0.2 * static_cast<double>(common))
+      << same << " of " << common;
+  const GenesisResult g = make(true, "0.05");
+  const double n = static_cast<double>(g.report.fj_bonded + g.report.fj_gapped + g.report.fj_slit);
+  EXPECT_NEAR(static_cast<double>(g.report.fj_bonded) / n, 0.8, 3 * std::sqrt(0.16 / n));
 }
