@@ -92,8 +92,8 @@ void finalize_contacts(Run& g) {
   for (std::size_t k = 0; k < N; ++k) {
     const std::size_t ci = candidates[k];
     is_bond[ci] = true;
-    // Per-contact draws: a stream of the contact's own (the seed and the grain pair), four
-    // uniforms for the type and two standard normals, whatever the card's values.
+    // Per-contact draws: a stream of the contact's own (the seed and the grain pair): one uniform
+    // for the type, then two uniforms per strength, whatever the card's values.
     Draws d = card.per_contact_draws ? Draws(card.seed, m.contacts()[ci].key) : Draws(g.rng);
     if (card.bonding == MaterialCard::Bonding::FlatJoint) {
       FlatJointProps fj = card.fj;

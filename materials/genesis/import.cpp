@@ -102,13 +102,10 @@ void import_grains(Run& g) {
     hi = hi.cwiseMax(q.x + Vec3::Constant(q.r));
     r_sum += q.r;
   }
-  const Vec3 centre =
-      dim == 3 ? Vec3(0.5 * (lo + hi)) : Vec3(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), 0);
+  const Vec3 centre = 0.5 * (lo + hi); // 2D: z stays 0 (-r_max and +r_max)
   std::vector<Vec3> x;
   for (Grain& q : grains) {
     q.x -= centre;
-    if (dim == 2)
-      q.x.z() = 0;
     x.push_back(q.x);
   }
   g.r_avg = r_sum / static_cast<double>(grains.size());

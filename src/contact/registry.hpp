@@ -130,6 +130,13 @@ template <class M> struct Batch {
   typename PoolOf<M>::type pool;
 };
 
+/// Capacity for n items and 1/16 more, when v has less (arrays rebuilt at each detection: growth
+/// by doubling would leave up to twice the data allocated).
+template <class V> void reserve_with_slack(V& v, std::size_t n) {
+  if (v.capacity() < n)
+    v.reserve(n + n / 16 + 64);
+}
+
 /// Per-model contiguous storage of contact data (parameters + state), indexed by a contact's slot.
 struct ModelBatches {
   typename registry_detail::Apply<AllModels>::template tuple<Batch> all;
@@ -143,18 +150,14 @@ struct ModelBatches {
   /// copied into these arrays, which grew by doubling without it (a 10k-grain flat-jointed
   /// specimen's set-up peaked at 55 MB in them against 22 MB of contact data).
   void reserve_like(const ModelBatches& other) {
-    auto grow = [](auto& v, std::size_t n) {
-      if (v.capacity() < n)
-        v.reserve(n + n / 16 + 64);
-    };
     std::apply(
         [&](auto&... b) {
           (
               [&](auto& mine) {
                 const auto& theirs = std::get<std::decay_t<decltype(mine)>>(other.all);
-                grow(mine.contacts, theirs.contacts.size());
+                reserve_with_slack(mine.contacts, theirs.contacts.size());
                 if constexpr (requires { mine.pool.all; })
-                  grow(mine.pool.all, theirs.pool.all.size());
+                  reserve_with_slack(mine.pool.all, theirs.pool.all.size());
               }(b),
               ...);
         },

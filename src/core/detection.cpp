@@ -164,11 +164,8 @@ void Model::gather_candidates(const CellGrid& g) {
 }
 
 void Model::reserve_lists() {
-  const std::size_t n = contacts_.size();
-  if (new_contacts_.capacity() < n) {
-    new_contacts_.reserve(n + n / 16 + 64);
-    new_outputs_.reserve(n + n / 16 + 64);
-  }
+  reserve_with_slack(new_contacts_, contacts_.size());
+  reserve_with_slack(new_outputs_, contacts_.size());
 }
 
 void Model::merge_candidates() {

@@ -45,14 +45,18 @@ void OutputDir::commit() {
   committed_ = true;
 }
 
-void write_text_file(const fs::path& p, const std::string& text) {
+void write_file(const fs::path& p, const std::function<void(std::ostream&)>& write) {
   std::ofstream out(p, std::ios::binary);
   if (!out)
     throw std::runtime_error(p.string() + ": cannot open for writing");
-  out << text;
+  write(out);
   out.close();
   if (!out)
     throw std::runtime_error(p.string() + ": write failed (disk full?)");
+}
+
+void write_text_file(const fs::path& p, const std::string& text) {
+  write_file(p, [&](std::ostream& out) { out << text; });
 }
 
 } // namespace rocklab

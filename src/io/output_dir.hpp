@@ -3,6 +3,8 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
+#include <iosfwd>
 #include <string>
 
 namespace rocklab {
@@ -26,7 +28,10 @@ private:
   bool committed_ = false;
 };
 
-/// Write text to a file; throws std::runtime_error naming the file on failure.
+/// Write a file by handing its stream to `write`; throws std::runtime_error naming the file when
+/// it cannot be opened or the write fails (disk full).
+void write_file(const std::filesystem::path& p, const std::function<void(std::ostream&)>& write);
+/// Write text to a file (write_file).
 void write_text_file(const std::filesystem::path& p, const std::string& text);
 
 } // namespace rocklab

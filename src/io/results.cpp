@@ -4,9 +4,7 @@
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <ostream>
-#include <stdexcept>
 
 namespace rocklab {
 
@@ -197,18 +195,6 @@ void write_results_json(std::ostream& os, const Model& m, const EventCounts& cou
     os << (k + 1 < head.size() ? ",\n" : "\n");
   }
   os << "}\n";
-}
-
-void write_results_file(const std::filesystem::path& path, const Model& m,
-                        const EventCounts& counts, const std::string& scene_file,
-                        ContactOutputMode mode) {
-  std::ofstream os(path, std::ios::binary);
-  if (!os)
-    throw std::runtime_error(path.string() + ": cannot open for writing");
-  write_results_json(os, m, counts, scene_file, mode);
-  os.close();
-  if (!os)
-    throw std::runtime_error(path.string() + ": write failed (disk full?)");
 }
 
 std::string history_header(const std::vector<HistoryColumn>& cols) {

@@ -6,7 +6,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <filesystem>
 #include <iosfwd>
 
 namespace rocklab {
@@ -24,11 +23,6 @@ bool contacts_written(ContactOutputMode mode, std::size_t contacts);
 /// when the list is left out, `contacts_omitted` saying why.
 void write_results_json(std::ostream& os, const Model& m, const EventCounts& counts,
                         const std::string& scene_file, ContactOutputMode mode);
-
-/// write_results_json into a file; a failed open or write (disk full) throws naming the file.
-void write_results_file(const std::filesystem::path& path, const Model& m,
-                        const EventCounts& counts, const std::string& scene_file,
-                        ContactOutputMode mode);
 
 /// Energies as a JSON object (joules).
 nlohmann::json energy_json(const EnergyLedger& e);

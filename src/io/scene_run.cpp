@@ -91,8 +91,9 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
   if (want_history && m.step() % scene.history_every != 0)
     history += history_row(m, scene.history, summary.events);
 
-  write_results_file(out.staged("results.json"), m, summary.events, scene.file,
-                     scene.contacts_output);
+  write_file(out.staged("results.json"), [&](std::ostream& os) {
+    write_results_json(os, m, summary.events, scene.file, scene.contacts_output);
+  });
   if (want_history)
     write_text_file(out.staged("history.csv"), history);
   else
