@@ -232,6 +232,7 @@ void read_installation(JsonObject& top, MaterialCard& c) {
     c.install_gap = i.number("gap", Range::non_negative(), 0.0, "m");
   c.residual_tolerance = i.number("residual_tolerance", Range::positive(), 0.05);
   c.per_contact_draws = i.choice("draws", {"sequence", "per_contact"}, "sequence") == "per_contact";
+  c.stiffness_ramp = i.integer("stiffness_ramp", 0, 1'000'000, 0);
   i.finish();
 }
 

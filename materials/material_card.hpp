@@ -65,6 +65,9 @@ struct MaterialCard {
   /// own key (common random numbers: a small parameter step changes few contacts, which a
   /// calibration needs); "sequence" (default) from one stream in shuffled contact order.
   bool per_contact_draws = false;
+  /// `installation.stiffness_ramp`: steps over which the card's stiffness replaces the soft
+  /// packing springs (geometric), the vessel servo holding the pressure; 0: at once.
+  std::int64_t stiffness_ramp = 0;
   // contacts
   LinearProps linear; ///< grain-wall, non-bonded and new contacts
   enum class Bonding { FlatJoint, ParallelBond, ContactBond, None } bonding = Bonding::FlatJoint;

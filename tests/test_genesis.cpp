@@ -129,6 +129,47 @@ TEST(Genesis, CylinderWithRockStiffness) {
   EXPECT_GT(checked, 1000u);
 }
 
+TEST(Genesis, StiffnessRampEndsAtTheCardsStiffnessInTheBands) {
+  // installation.stiffness_ramp: the card's stiffness replaces the soft packing springs over that
+  // many steps (geometric, the vessel servo holding the pressure) instead of at once. The ramp
+  // must end at exactly the card's stiffness, count in the installation steps and still reach the
+  // porosity, pressure and residual-stress bands.
+  const std::string ramped = edited_card("genesis_3d_cylinder.json", "\"gap_ratio\": 0.05}",
+                                         "\"gap_ratio\": 0.05, \"stiffness_ramp\": 4000}");
+  const MaterialCard c = load_material_card(ramped);
+  ASSERT_EQ(c.stiffness_ramp, 4000);
+  const GenesisResult g = run_genesis(c);
+  const GenesisReport& r = g.report;
+  EXPECT_NEAR(r.porosity, c.porosity, 0.005);
+  for (const auto& [wall, s] : r.wall_stress)
+    EXPECT_TRUE(near_rel(s, c.pressure, c.pressure_tolerance)) << wall;
+  EXPECT_LE(std::abs(r.residual_mean_stress), c.residual_tolerance * c.pressure);
+  EXPECT_GE(r.steps_installation, 4000);
+  // At the end of installation every grain-grain spring has exactly the card's stiffness (the
+  // stages run by hand up to there).
+  Model m;
+  m.settings.dim = c.dim;
+  m.settings.local_damping = 0.7;
+  m.settings.gravity = Vec3::Zero();
+  GenesisReport rep;
+  const std::function<void(const std::string&)> quiet;
+  genesis::Run run(c, m, rep, quiet, nullptr);
+  genesis::place_grains(run);
+  genesis::relax_cloud(run);
+  genesis::compact(run);
+  std::size_t springs = 0;
+  for (const Contact& ct : m.contacts())
+    if (ct.kind == ContactKind::BallBall && ct.model == model_kind<Linear>) {
+      EXPECT_EQ(m.batches().of<Linear>().contacts[ct.slot].p.kn, run.stiff.kn);
+      ++springs;
+    }
+  EXPECT_GT(springs, 500u);
+  EXPECT_EQ(std::get<LinearProps>(m.rules[0].props).kn, run.stiff.kn);
+  EXPECT_THROW(load_material_card(edited_card("genesis_3d_cylinder.json", "\"gap_ratio\": 0.05}",
+                                              "\"gap_ratio\": 0.05, \"stiffness_ramp\": -1}")),
+               InputError);
+}
+
 TEST(Genesis, TypeFractionsOnAThreeThousandGrainSpecimen) {
   const MaterialCard c = load_material_card(card("genesis_2d_3k.json"));
   const GenesisResult g = run_genesis(c);

@@ -20,14 +20,14 @@ void set_packing_friction(Model& m, double f) {
   m.set_property(model_kind<Linear>, "fric", f, ContactSelect::BallBall);
 }
 
-void install_card_stiffness(Run& g) {
+void install_card_stiffness(Run& g, double fraction = 1.0) {
   Model& m = g.m;
   LinearProps& b = std::get<LinearProps>(m.rules[0].props);
   LinearProps& w = std::get<LinearProps>(m.rules[1].props);
-  b.kn = g.stiff.kn;
-  b.ks = g.stiff.ks;
-  w.kn = 2 * g.stiff.kn;
-  w.ks = 2 * g.stiff.ks;
+  b.kn = fraction * g.stiff.kn;
+  b.ks = fraction * g.stiff.ks;
+  w.kn = 2 * b.kn;
+  w.ks = 2 * b.ks;
   m.set_property(model_kind<Linear>, "kn", b.kn, ContactSelect::BallBall);
   m.set_property(model_kind<Linear>, "ks", b.ks, ContactSelect::BallBall);
   m.set_property(model_kind<Linear>, "kn", w.kn, ContactSelect::BallFacet);
@@ -47,12 +47,26 @@ void stop_walls(Model& m) {
 void lock_packing(Run& g) {
   Model& m = g.m;
   set_packing_friction(m, g.card.packing_friction);
-  install_card_stiffness(g);
   for (std::size_t i = 0; i < m.balls.size(); ++i) {
     m.balls.vel[i].setZero();
     m.balls.spin[i].setZero();
   }
   stop_walls(m);
+  const std::int64_t n = g.card.stiffness_ramp;
+  if (n > 0) {
+    const double soft = std::get<LinearProps>(m.rules[0].props).kn / g.stiff.kn;
+    const std::int64_t stages = 20;
+    for (std::int64_t i = 1; i <= stages; ++i) {
+      install_card_stiffness(g, std::pow(soft, 1.0 - static_cast<double>(i) / stages));
+      for (std::int64_t k = 0; k < n / stages; ++k) {
+        g.servo_step(g.card.pressure);
+        m.cycle(1);
+      }
+      m.clear_events();
+      g.check_interrupt();
+    }
+  }
+  install_card_stiffness(g);
   g.run_until("settling the locked packing", 50,
               [&] { return m.mean_unbalanced_force_ratio() <= 1e-2; });
   g.speed_cap = 0.001;
