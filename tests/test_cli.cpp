@@ -168,6 +168,22 @@ TEST(Cli, HelpAndVersion) {
   EXPECT_NE(msg.find("SI"), std::string::npos);
 }
 
+TEST(Cli, BadCommandLinesExitWithTwoAndSayWhy) {
+  // No subcommand: the usage; an unknown option, a missing argument or a negative count: CLI11's
+  // message. Every one is an input error (status 2), never CLI11's own 100+ codes.
+  std::string msg;
+  EXPECT_EQ(run_command(binary(), &msg), 2);
+  EXPECT_NE(msg.find("genesis"), std::string::npos) << msg;
+  EXPECT_EQ(run_command(binary() + " test", &msg), 2);
+  EXPECT_NE(msg.find("protocol"), std::string::npos) << msg;
+  EXPECT_EQ(run_command(binary() + " genesis x.json -o y --seed -5", &msg), 2);
+  EXPECT_NE(msg.find("seed"), std::string::npos) << msg;
+  EXPECT_EQ(run_command(binary() + " genesis x.json -o y --seed 99999999999999999999999", &msg), 2);
+  EXPECT_NE(msg.find("seed"), std::string::npos) << msg;
+  EXPECT_EQ(run_command(binary() + " info --bogus", &msg), 2);
+  EXPECT_NE(msg.find("bogus"), std::string::npos) << msg;
+}
+
 TEST(Cli, EveryExampleRuns) {
   std::size_t count = 0;
   for (const auto& entry : fs::recursive_directory_iterator(source_dir() + "/examples")) {

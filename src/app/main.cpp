@@ -13,6 +13,7 @@
 #include <omp.h>
 
 #include <atomic>
+#include <charconv>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -275,6 +276,19 @@ int guarded(const std::function<int()>& command) {
   }
 }
 
+// A seed: a whole number in [0, 2^63), checked on the text (a number too large for 64 bits must
+// not be clamped silently).
+const CLI::Validator kSeed(
+    [](std::string& text) -> std::string {
+      std::int64_t v = 0;
+      const char* end = text.data() + text.size();
+      const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+      if (ec != std::errc() || ptr != end || v < 0)
+        return "Value " + text + " is not a seed: a whole number in [0, 2^63)";
+      return {};
+    },
+    "SEED");
+
 int main(int argc, char** argv) {
   CLI::App app{"rocklab - a virtual rock-mechanics laboratory (bonded-particle DEM).\n"
                "All input and output quantities are SI units (m, kg, s, N, Pa, J)."};
@@ -310,8 +324,7 @@ int main(int argc, char** argv) {
                   "\"diameter\": 0.05, \"thickness\": 0.025}')");
   gen->add_option("--cut", gen_cut,
                   "Replace the card's cut (a test shape cut from the block, JSON)");
-  gen->add_option("--seed", gen_seed, "Replace the card's random seed")
-      ->check(CLI::NonNegativeNumber);
+  gen->add_option("--seed", gen_seed, "Replace the card's random seed, [0, 2^63)")->check(kSeed);
 
   std::string protocol_file, test_out, resume;
   std::int64_t checkpoint_every = 0;
@@ -345,7 +358,18 @@ int main(int argc, char** argv) {
   CLI::App* info =
       app.add_subcommand("info", "Print the version, threads, contact models and lab tests");
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) { // --help, --version
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // Bad command lines are input errors: the message, the usage, status 2 (CLI11's own codes
+    // run from 100 up).
+    app.exit(e);
+    if (argc < 2)
+      std::cerr << app.help();
+    return 2;
+  }
   if (threads > 0 && !*suite)
     omp_set_num_threads(threads);
   std::signal(SIGINT, on_signal);
