@@ -101,10 +101,14 @@ GenesisResult run_genesis(const MaterialCard& card,
   genesis::Run run(card, m, rep, progress, interrupt);
   if (card.packing_import.empty()) {
     genesis::place_grains(run);
-    genesis::relax_cloud(run);
-    genesis::remove_escaped(run);
-    genesis::compact(run);
-    genesis::remove_escaped(run);
+    const genesis::PackingKey key = genesis::packing_key(run);
+    if (!genesis::load_packing(run, key)) {
+      genesis::relax_cloud(run);
+      genesis::remove_escaped(run);
+      genesis::compact(run);
+      genesis::remove_escaped(run);
+      genesis::store_packing(run, key);
+    }
   } else {
     genesis::import_grains(run);
   }

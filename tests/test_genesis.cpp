@@ -170,6 +170,61 @@ TEST(Genesis, StiffnessRampEndsAtTheCardsStiffnessInTheBands) {
                InputError);
 }
 
+TEST(Genesis, PackingCacheGivesTheSameSpecimenAndIsKeyedByWhatPackingReads) {
+  // ROCKLAB_PACKING_CACHE keeps the installed packing; a card that differs only in what
+  // finalization reads (strengths, the gap below the packing margin) reuses it, and the specimen
+  // is byte for byte the one made without the cache.
+  const fs::path dir = rocklab::test::scratch_root() / "rocklab-packing-cache";
+  fs::remove_all(dir);
+  auto variant = [](const char* gap, const char* ten, const char* porosity) {
+    std::string text = test::read_file(card("genesis_2d_rect.json"));
+    for (auto [from, to] : {std::pair<std::string, std::string>{"\"gap_ratio\": 0.05", gap},
+                            {"\"fj_ten\": {\"mean\": 1e6", ten},
+                            {"\"porosity\": 0.19", porosity}}) {
+      const auto at = text.find(from);
+      EXPECT_NE(at, std::string::npos) << from;
+      text.replace(at, from.size(), to);
+    }
+    const fs::path p = rocklab::test::scratch_root() / "cache-card.json";
+    std::ofstream(p) << text;
+    return load_material_card(p.string());
+  };
+  auto bytes = [](const MaterialCard& c, bool* hit = nullptr) {
+    bool from_cache = false;
+    const GenesisResult g = run_genesis(
+        c, [&](const std::string& s) { from_cache |= s.find("from the cache") != s.npos; });
+    if (hit)
+      *hit = from_cache;
+    const fs::path f = rocklab::test::scratch_root() / "cache-specimen.rlspec";
+    save_model(*g.model, f.string(), specimen_meta(c, g.report));
+    return test::read_file(f);
+  };
+  auto files = [&] { return std::distance(fs::directory_iterator(dir), fs::directory_iterator{}); };
+  const MaterialCard a =
+      variant("\"gap_ratio\": 0.03", "\"fj_ten\": {\"mean\": 1e6", "\"porosity\": 0.19");
+  const MaterialCard b =
+      variant("\"gap_ratio\": 0.04", "\"fj_ten\": {\"mean\": 2e6", "\"porosity\": 0.19");
+  const MaterialCard c =
+      variant("\"gap_ratio\": 0.04", "\"fj_ten\": {\"mean\": 2e6", "\"porosity\": 0.195");
+  unsetenv("ROCKLAB_PACKING_CACHE");
+  const std::string plain_a = bytes(a), plain_b = bytes(b);
+  ASSERT_NE(plain_a, plain_b);
+  setenv("ROCKLAB_PACKING_CACHE", dir.c_str(), 1);
+  bool hit = true;
+  EXPECT_EQ(bytes(a, &hit), plain_a);
+  EXPECT_FALSE(hit);
+  EXPECT_EQ(files(), 1);
+  EXPECT_EQ(bytes(a, &hit), plain_a);
+  EXPECT_TRUE(hit);
+  EXPECT_EQ(bytes(b, &hit), plain_b); // other strengths and gap: the same packing
+  EXPECT_TRUE(hit);
+  EXPECT_EQ(files(), 1);
+  bytes(c, &hit); // another porosity: another packing
+  EXPECT_FALSE(hit);
+  EXPECT_EQ(files(), 2);
+  unsetenv("ROCKLAB_PACKING_CACHE");
+}
+
 TEST(Genesis, TypeFractionsOnAThreeThousandGrainSpecimen) {
   const MaterialCard c = load_material_card(card("genesis_2d_3k.json"));
   const GenesisResult g = run_genesis(c);

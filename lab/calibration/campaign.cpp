@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include <sys/resource.h>
@@ -82,6 +83,11 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   const double cpu0 = children_cpu_seconds();
   const CalibrationFile c = load_calibration(file);
   fs::create_directories(o.out_dir);
+  // Every evaluation packs each seed's specimens again although only stage 1 changes what
+  // packing reads: keep the installed packings beside the evaluations (materials/genesis/
+  // packing_cache.cpp; the test processes inherit the setting), unless the user chose a folder.
+  if (const char* dir = std::getenv("ROCKLAB_PACKING_CACHE"); !dir || !*dir)
+    setenv("ROCKLAB_PACKING_CACHE", fs::absolute(fs::path(o.out_dir) / "packings").c_str(), 1);
   Evaluator ev(c, o);
   std::vector<Param> params;
   for (const CardParam& p : c.params)

@@ -134,4 +134,16 @@ void finalize_contacts(Run& g); ///< finalization.cpp: bonds where the gap is wi
 void release(Run& g);           ///< release.cpp: unload and remove the vessel, cut, relax
 void insert_joints(Run& g);     ///< joints.cpp: contacts across joint planes become smooth joints
 
+/// packing_cache.cpp: the compacted, installed packing kept in the folder ROCKLAB_PACKING_CACHE
+/// names (off when unset or for an imported packing), keyed by every input read before
+/// finalization and by the program's own bytes.
+struct PackingKey {
+  std::string file; ///< empty: no cache
+  nlohmann::json inputs;
+};
+PackingKey packing_key(const Run& g); ///< after place_grains (the margin needs the mean radius)
+/// Restore the model, the run's state and the report from the cache; false on a miss.
+bool load_packing(Run& g, const PackingKey& key);
+void store_packing(const Run& g, const PackingKey& key);
+
 } // namespace rocklab::genesis

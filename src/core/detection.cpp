@@ -59,6 +59,9 @@ struct detail::CellGrid {
 };
 
 void Model::detect() {
+  // Editing calls (set_margin, ...) may detect before any cycle, e.g. on a model just read from a
+  // file, whose per-thread buffers do not exist yet.
+  ensure_thread_buffers();
   candidate_keys_.clear();
   if (balls.size() > 0) {
     const CellGrid grid = bin_balls();
