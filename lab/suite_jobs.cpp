@@ -41,6 +41,13 @@ void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
   std::size_t next = 0, running = 0;
   std::map<pid_t, std::size_t> live;
   bool stopping = false;
+  auto stop = [&] { // no new jobs; the running ones get SIGINT (they finish as interrupted)
+    if (stopping)
+      return;
+    stopping = true;
+    for (const auto& [p, k] : live)
+      kill(p, SIGINT);
+  };
   while (next < jobs.size() || running > 0) {
     while (!stopping && running < static_cast<std::size_t>(parallel) && next < jobs.size()) {
       jobs[next].start = std::chrono::steady_clock::now();
@@ -66,13 +73,17 @@ void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
       if (o.progress)
         std::fprintf(stderr, "[rocklab suite] %s %s in %.1f s\n", j.label.c_str(),
                      j.status == 0 ? "finished" : "FAILED", j.seconds);
+      // A child that was interrupted (status 130) or stopped from outside (SIGINT, SIGTERM,
+      // SIGHUP, SIGKILL) did not fail on its input: the signal reached it before this process
+      // (kill -- -PGID, a batch system), and the suite stops as interrupted instead of recording
+      // a failed test (which a calibration would cache). A crash stays a failed test.
+      const int sig = WIFSIGNALED(st) ? WTERMSIG(st) : 0;
+      if (j.status == 130 || sig == SIGINT || sig == SIGTERM || sig == SIGHUP || sig == SIGKILL)
+        stop();
       continue;
     }
-    if (!stopping && o.interrupt && o.interrupt->load()) {
-      stopping = true;
-      for (const auto& [p, k] : live)
-        kill(p, SIGINT);
-    }
+    if (o.interrupt && o.interrupt->load())
+      stop();
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   if (stopping)

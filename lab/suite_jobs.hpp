@@ -23,7 +23,8 @@ struct Job {
 
 /// Run the jobs, at most `parallel` at once; fills each job's status and seconds. On interrupt
 /// the children (which got the same signal from the terminal, or get SIGINT from here) are waited
-/// for and the suite fails.
+/// for and the suite fails; so it does when a child exits with 130 or dies by a signal (the
+/// signal reached it first).
 void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o);
 
 } // namespace rocklab

@@ -7,6 +7,7 @@
 #include "lab/protocols/brazilian.hpp"
 #include "lab/run_test.hpp"
 #include "lab/suite.hpp"
+#include "lab/suite_jobs.hpp"
 #include "viz/vtk_output.hpp"
 
 #include <array>
@@ -421,6 +422,32 @@ TEST(Lab, EnvelopeFitRecoversMohrCoulombAndHoekBrown) {
   EXPECT_TRUE(test::near_rel(e.hb_mi, mi, 1e-9));
   EXPECT_TRUE(test::near_rel(e.hb_sigma_c, sc, 1e-9));
   EXPECT_FALSE(fit_envelope({0, 2e6}, {1e8, 1.1e8}).has_hb); // two points: no Hoek-Brown
+}
+
+TEST(Lab, AChildStoppedFromOutsideStopsTheSuiteAsInterrupted) {
+  // A test process that exits with 130 (interrupted) or dies by SIGTERM/SIGKILL was stopped from
+  // outside (the signal reached it before the suite's own handler): the suite must fail as
+  // interrupted, not record a failed test that a calibration would then cache. An ordinary
+  // failure and a crash are recorded as failed tests and the other jobs still run.
+  const std::string log = (test::scratch_root() / "job.log").string();
+  auto job = [&](const std::string& script) {
+    Job j;
+    j.label = script;
+    j.argv = {"/bin/sh", "-c", script};
+    j.log = log;
+    return j;
+  };
+  SuiteOptions o;
+  for (const char* stopped : {"exit 130", "kill -TERM $$", "kill -KILL $$"}) {
+    std::vector<Job> jobs{job(stopped), job("sleep 0.3; exit 0"), job("exit 0")};
+    EXPECT_THROW(run_jobs(jobs, 1, o), std::runtime_error) << stopped;
+    EXPECT_EQ(jobs[2].status, -1) << stopped; // nothing new was started
+  }
+  std::vector<Job> jobs{job("exit 1"), job("kill -SEGV $$"), job("exit 0")};
+  EXPECT_NO_THROW(run_jobs(jobs, 2, o));
+  EXPECT_EQ(jobs[0].status, 1);
+  EXPECT_EQ(jobs[1].status, 128 + SIGSEGV);
+  EXPECT_EQ(jobs[2].status, 0);
 }
 
 TEST(Lab, SuiteRunsTestsInParallelAndSummarises) {

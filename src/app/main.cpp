@@ -289,6 +289,23 @@ const CLI::Validator kSeed(
     },
     "SEED");
 
+// Parse; -1 to go on, else the exit status: 0 after --help or --version, 2 for a bad command line
+// (an input error like any other; CLI11's own codes run from 100 up), with the usage when no
+// subcommand was given.
+int parse_command_line(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    if (argc < 2)
+      std::cerr << app.help();
+    return 2;
+  }
+  return -1;
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"rocklab - a virtual rock-mechanics laboratory (bonded-particle DEM).\n"
                "All input and output quantities are SI units (m, kg, s, N, Pa, J)."};
@@ -358,18 +375,8 @@ int main(int argc, char** argv) {
   CLI::App* info =
       app.add_subcommand("info", "Print the version, threads, contact models and lab tests");
 
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::Success& e) { // --help, --version
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    // Bad command lines are input errors: the message, the usage, status 2 (CLI11's own codes
-    // run from 100 up).
-    app.exit(e);
-    if (argc < 2)
-      std::cerr << app.help();
-    return 2;
-  }
+  if (const int rc = parse_command_line(app, argc, argv); rc >= 0)
+    return rc;
   if (threads > 0 && !*suite)
     omp_set_num_threads(threads);
   std::signal(SIGINT, on_signal);
