@@ -202,6 +202,7 @@ void read_packing(JsonObject& top, MaterialCard& c) {
   if (c.cloud_porosity <= c.porosity)
     p.fail("cloud_porosity", "must exceed the target porosity " + std::to_string(c.porosity));
   c.max_overlap_ratio = p.number("max_overlap_ratio", Range::positive(), 0.25);
+  c.packing_margin_ratio = p.number("margin_ratio", {0, 1, true, false}, 0.0);
   c.equilibrium_ratio = p.number("equilibrium_ratio", Range::positive(), 5e-3);
   c.max_cycles = p.integer("max_cycles", 1000, std::numeric_limits<std::int64_t>::max(), 2'000'000);
   c.eliminate_floaters = p.boolean("eliminate_floaters", false);

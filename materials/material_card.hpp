@@ -55,6 +55,9 @@ struct MaterialCard {
   double compaction_strain = 5e-4;   ///< p / E* of the soft springs used for compaction [-]
   double cloud_porosity = 0.5;
   double max_overlap_ratio = 0.25;
+  /// `packing.margin_ratio`: detection margin / R_avg while packing; <= 0 (default): the old rule
+  /// max(0.05 R_avg, g_i), which ties the packing to the installation gap.
+  double packing_margin_ratio = 0;
   double equilibrium_ratio = 5e-3; ///< mean unbalanced-force ratio for "at rest"
   std::int64_t max_cycles = 2'000'000;
   // installation

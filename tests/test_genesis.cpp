@@ -225,6 +225,30 @@ TEST(Genesis, PackingCacheGivesTheSameSpecimenAndIsKeyedByWhatPackingReads) {
   unsetenv("ROCKLAB_PACKING_CACHE");
 }
 
+TEST(Genesis, APackingMarginRatioMakesThePackingIndependentOfTheInstallationGap) {
+  // By default a gap above 0.05 R_avg widens the packing's detection margin, and with it the time
+  // step and the whole packing; with packing.margin_ratio the packing (every step of it) is the
+  // same whatever the gap, and only the bonds differ.
+  auto run = [](const char* gap, bool ratio) {
+    const GenesisResult g = run_genesis(load_material_card(
+        edited_card("genesis_2d_rect.json", "\"gap_ratio\": 0.05}",
+                    std::string("\"gap_ratio\": ") + gap + "}" +
+                        (ratio ? ", \"packing\": {\"margin_ratio\": 0.05}" : ""))));
+    return g.report;
+  };
+  const GenesisReport a = run("0.08", true), b = run("0.12", true);
+  EXPECT_EQ(a.porosity_installed, b.porosity_installed);
+  EXPECT_EQ(a.steps_packing, b.steps_packing);
+  EXPECT_EQ(a.steps_installation, b.steps_installation);
+  EXPECT_LT(a.fj_bonded + a.fj_gapped + a.fj_slit, b.fj_bonded + b.fj_gapped + b.fj_slit);
+  const GenesisReport c = run("0.08", false), d = run("0.12", false);
+  EXPECT_NE(c.porosity_installed, d.porosity_installed);
+  EXPECT_THROW(load_material_card(edited_card("genesis_2d_rect.json", "\"gap_ratio\": 0.05}",
+                                              "\"gap_ratio\": 0.05}, \"packing\": "
+                                              "{\"margin_ratio\": 0}")),
+               InputError);
+}
+
 TEST(Genesis, TypeFractionsOnAThreeThousandGrainSpecimen) {
   const MaterialCard c = load_material_card(card("genesis_2d_3k.json"));
   const GenesisResult g = run_genesis(c);

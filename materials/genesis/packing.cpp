@@ -26,6 +26,11 @@ double max_overlap_ratio(const Model& m) {
 
 } // namespace
 
+double packing_margin(const MaterialCard& card, double r_avg) {
+  return card.packing_margin_ratio > 0 ? card.packing_margin_ratio * r_avg
+                                       : std::max(0.05 * r_avg, card.install_gap);
+}
+
 void relax_cloud(Run& g) {
   Model& m = g.m;
   const MaterialCard& card = g.card;
@@ -64,7 +69,7 @@ void relax_cloud(Run& g) {
   pack_wall.ks *= 2;
   bf.props = pack_wall;
   m.rules = {bb, bf};
-  m.settings.margin = std::max(0.05 * r_avg, card.install_gap);
+  m.settings.margin = packing_margin(card, r_avg);
   m.settings.overlap_check = false; // a cloud overlaps by design
   m.initialize();
 

@@ -53,7 +53,7 @@ nlohmann::json packing_inputs(const Run& g) {
     for (const char* k : {"gap", "gap_ratio", "draws", "residual_tolerance"})
       j["installation"].erase(k);
   char margin[40];
-  std::snprintf(margin, sizeof margin, "%.17g", std::max(0.05 * g.r_avg, c.install_gap));
+  std::snprintf(margin, sizeof margin, "%.17g", packing_margin(c, g.r_avg));
   return {{"format", kFormat},
           {"program", program_hash()},
           {"card", j},

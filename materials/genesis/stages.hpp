@@ -124,7 +124,10 @@ std::vector<std::size_t> morton_order(const std::vector<Vec3>& x, int dim, doubl
 void place_grains(Run& g); ///< cloud.cpp: radii, a cloud in the enlarged vessel, Morton order
 /// import.cpp: instead of the three above, grains read from the card's `packing.import`
 void import_grains(Run& g);
-void relax_cloud(Run& g);     ///< packing.cpp: soft packing springs, the cloud relaxed
+void relax_cloud(Run& g); ///< packing.cpp: soft packing springs, the cloud relaxed
+/// packing.cpp: the detection margin while packing [m]: `packing.margin_ratio` R_avg, or by
+/// default max(0.05 R_avg, g_i) (finalization raises it to 1.01 g_i in either case).
+double packing_margin(const MaterialCard& card, double r_avg);
 void compact(Run& g);         ///< compaction.cpp: to the porosity at the pressure, installed
 void remove_floaters(Run& g); ///< floaters.cpp: count floaters, coordination; remove if asked
 /// floaters.cpp: remove grains whose centre has left the vessel (after the cloud and compaction)
