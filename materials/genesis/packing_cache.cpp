@@ -6,6 +6,7 @@
 // archive), so the specimen is byte-identical to the one made without the cache. Units SI.
 #include "materials/genesis/stages.hpp"
 
+#include "io/json_fields.hpp"
 #include "io/specimen.hpp"
 
 #include <cstdio>
@@ -33,13 +34,6 @@ const std::string& program_hash() {
   return h;
 }
 
-nlohmann::json vec_json(const Vec3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-Vec3 vec_of(const nlohmann::json& j) {
-  return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
-}
-
 // The card's keys that packing, compaction and installation read: all of them except the
 // bonds, joints, names, the installation gap (read as the packing margin it sets) and what
 // finalization and release read.
@@ -63,68 +57,36 @@ nlohmann::json packing_inputs(const Run& g) {
           {"packing_margin", margin}};
 }
 
-nlohmann::json run_state(const Run& g) {
-  std::ostringstream rng;
-  rng << g.rng;
-  nlohmann::json servos = nlohmann::json::array();
-  for (const Servo& s : g.vessel.servos)
-    servos.push_back({{"wall", s.wall}, {"n_in", vec_json(s.n_in)}, {"radial", s.radial}});
-  const GenesisReport& r = g.rep;
-  nlohmann::json walls = nlohmann::json::array();
-  for (const auto& [name, s] : r.wall_stress)
-    walls.push_back({name, s});
-  return {{"r_avg", g.r_avg},
-          {"speed_cap", g.speed_cap},
-          {"largest_half", g.largest_half},
-          {"installed_volume", g.installed_volume},
-          {"rng", rng.str()},
-          {"vessel", {{"dim", g.vessel.dim}, {"shape", static_cast<int>(g.vessel.shape)}}},
-          {"servos", servos},
-          {"report",
-           {{"escaped", r.escaped},
-            {"porosity_target", r.porosity_target},
-            {"porosity_packed", r.porosity_packed},
-            {"porosity_installed", r.porosity_installed},
-            {"porosity", r.porosity},
-            {"packing_friction", r.packing_friction},
-            {"pressure", r.pressure},
-            {"wall_stress", walls},
-            {"shape", shape_json(r.shape, g.card.dim)},
-            {"steps_packing", r.steps_packing},
-            {"steps_installation", r.steps_installation}}}};
-}
-
-void restore_state(Run& g, const nlohmann::json& j, const std::string& file) {
-  g.r_avg = j.at("r_avg").get<double>();
-  g.speed_cap = j.at("speed_cap").get<double>();
-  g.largest_half = j.at("largest_half").get<double>();
-  g.installed_volume = j.at("installed_volume").get<double>();
-  std::istringstream rng(j.at("rng").get<std::string>());
-  rng >> g.rng;
-  if (!rng)
-    throw std::runtime_error(file + ": corrupt packing cache (random generator state)");
-  g.vessel.dim = j.at("vessel").at("dim").get<int>();
-  g.vessel.shape = static_cast<SpecimenShape>(j.at("vessel").at("shape").get<int>());
-  g.vessel.servos.clear();
-  for (const auto& s : j.at("servos"))
-    g.vessel.servos.push_back(
-        {s.at("wall").get<std::size_t>(), vec_of(s.at("n_in")), s.at("radial").get<bool>()});
-  const auto& r = j.at("report");
-  GenesisReport& rep = g.rep;
-  rep.escaped = r.at("escaped").get<std::int64_t>();
-  rep.porosity_target = r.at("porosity_target").get<double>();
-  rep.porosity_packed = r.at("porosity_packed").get<double>();
-  rep.porosity_installed = r.at("porosity_installed").get<double>();
-  rep.porosity = r.at("porosity").get<double>();
-  rep.packing_friction = r.at("packing_friction").get<double>();
-  rep.pressure = r.at("pressure").get<double>();
-  rep.wall_stress.clear();
-  for (const auto& w : r.at("wall_stress"))
-    rep.wall_stress.emplace_back(w.at(0).get<std::string>(), w.at(1).get<double>());
-  rep.shape = shape_from_json(r.at("shape"), g.card.dim, file, "report.shape");
-  rep.steps_packing = r.at("steps_packing").get<std::int64_t>();
-  rep.steps_installation = r.at("steps_installation").get<std::int64_t>();
-}
+// What the stages after compaction read of the run (besides the model), and the report so far,
+// as named fields (io/json_fields.hpp, the checkpoints' archive).
+struct PackedState {
+  Run& g;
+  template <class A> void fields(A& a) {
+    GenesisReport& r = g.rep;
+    std::string rng;
+    if constexpr (!A::reading) {
+      std::ostringstream s;
+      s << g.rng;
+      rng = s.str();
+    }
+    a("r_avg", g.r_avg), a("speed_cap", g.speed_cap), a("largest_half", g.largest_half);
+    a("installed_volume", g.installed_volume), a("rng", rng);
+    a("vessel_dim", g.vessel.dim), a("vessel_shape", g.vessel.shape);
+    a.objects("servos", g.vessel.servos);
+    a("escaped", r.escaped), a("porosity_target", r.porosity_target);
+    a("porosity_packed", r.porosity_packed), a("porosity_installed", r.porosity_installed);
+    a("porosity", r.porosity), a("packing_friction", r.packing_friction);
+    a("pressure", r.pressure), a("wall_stress", r.wall_stress);
+    a("shape", r.shape.shape), a("shape_size", r.shape.size);
+    a("steps_packing", r.steps_packing), a("steps_installation", r.steps_installation);
+    if constexpr (A::reading) {
+      std::istringstream s(rng);
+      s >> g.rng;
+      if (!s)
+        throw InputError(a.file + ": corrupt packing cache (random generator state)");
+    }
+  }
+};
 
 } // namespace
 
@@ -146,11 +108,8 @@ bool load_packing(Run& g, const PackingKey& key) {
   // The name is a 64-bit hash: the file must also hold these very inputs.
   if (meta.value("inputs", nlohmann::json()) != key.inputs)
     return false;
-  try {
-    restore_state(g, meta.at("run"), key.file);
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(key.file + ": corrupt packing cache (" + e.what() + ")");
-  }
+  JsonFieldReader r{meta.value("run", nlohmann::json()), key.file};
+  PackedState{g}.fields(r);
   g.m = std::move(*m);
   g.say("packing from the cache " + key.file);
   return true;
@@ -162,7 +121,10 @@ void store_packing(const Run& g, const PackingKey& key) {
   std::filesystem::create_directories(std::filesystem::path(key.file).parent_path());
   // A name of this process's own, then one rename: concurrent campaigns may make the same packing.
   const std::string tmp = key.file + "." + std::to_string(::getpid());
-  save_model(g.m, tmp, {{"inputs", key.inputs}, {"run", run_state(g)}});
+  nlohmann::json state = nlohmann::json::object();
+  JsonFieldWriter w{state};
+  PackedState{const_cast<Run&>(g)}.fields(w); // the writer only reads
+  save_model(g.m, tmp, {{"inputs", key.inputs}, {"run", state}});
   std::filesystem::rename(tmp, key.file);
 }
 

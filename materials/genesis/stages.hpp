@@ -28,6 +28,7 @@ struct Servo {
   std::size_t wall = 0;
   Vec3 n_in = Vec3::Zero(); ///< planar walls: inward normal
   bool radial = false;      ///< the round wall (cylinder or circle)
+  template <class A> void fields(A& a) { a("wall", wall), a("n_in", n_in), a("radial", radial); }
 };
 
 /// The vessel of the card's specimen shape: planar walls and, for round shapes, a cylinder

@@ -19,7 +19,6 @@ void Model::force_displacement(double dt) {
   const std::size_t nc = contacts_.size();
   const std::size_t none = std::numeric_limits<std::size_t>::max();
   std::size_t blowup = none;
-  ensure_thread_buffers(); // also when called before any cycle (a model just read from a file)
   for (auto& buf : thread_events_)
     buf.clear();
 #pragma omp parallel reduction(min : blowup) if (nc >= kParallelMin)
