@@ -68,6 +68,10 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     p.confinement_tolerance = l.number("confinement_tolerance", {0, 0.5, true, false}, 0.01);
     p.grip_fraction = l.number("grip_fraction", {0, 0.4, true, false}, 0.1);
     p.reverse_at_strain = l.number("reverse_at_strain", {0, 0.1, false, false}, 0.0);
+    if (l.choice("jaws", {"flat", "curved"}, "flat") == "curved")
+      p.jaw_radius_ratio = l.number("jaw_radius_ratio", Range::closed(1.1, 10), 1.5);
+    else if (l.has("jaw_radius_ratio"))
+      l.fail("jaw_radius_ratio", "applies to \"jaws\": \"curved\" only");
     test->check_loading(l, p);
     l.finish();
   }

@@ -34,6 +34,8 @@ struct Protocol {
   double confinement_tolerance = 0.01;     ///< servo band during the confinement phase [-]
   double grip_fraction = 0.1;              ///< direct tension: grips are grains this near an end
   double reverse_at_strain = 0; ///< > 0: unload from this axial strain back to zero (elastic test)
+  /// Brazilian: 0 flat platens; > 0 curved jaws (ISRM 1978) of this times the disk's radius.
+  double jaw_radius_ratio = 0;
   // stop
   double post_peak_fraction = 0.9; ///< stop when the load falls to this fraction of its peak
   std::int64_t min_steps = 1000;   ///< ... but not before this many loading steps

@@ -4,7 +4,10 @@
 
 #include "io/json_input.hpp"
 #include "io/specimen.hpp"
+#include "lab/frame/loading_frame.hpp"
+#include "lab/protocol_table.hpp"
 #include "lab/protocols/brazilian.hpp"
+#include "lab/protocols/frame_test.hpp"
 #include "lab/run_test.hpp"
 #include "lab/suite.hpp"
 #include "lab/suite_jobs.hpp"
@@ -348,6 +351,88 @@ TEST(Lab, BrazilianAndDirectTension) {
   EXPECT_LT(dt.results["tensile_strength_Pa"].get<double>(), 5e6);
 }
 
+// The tiny test disk, made once by a Brazilian run with flat platens (its results serve too).
+const LabSummary& flat_disk_run() {
+  static const LabSummary s = run(
+      "bz_flat",
+      {{"test", "brazilian"},
+       {"specimen",
+        {{"material", data("lab_2d_fj.json")}, {"shape", {{"shape", "disk"}, {"diameter", 0.02}}}}},
+       {"output", {{"vtk", false}, {"plots", false}}}},
+      scratch("bz_flat"));
+  return s;
+}
+
+TEST(Lab, CurvedJawsLoadTheDiskOverAnArcAndSplitIt) {
+  const LabSummary& flat = flat_disk_run();
+  const std::string spec = (test::scratch_root() / "bz_flat" / "specimen.rlspec").string();
+  const LabSummary cj = run("bz_curved",
+                            {{"test", "brazilian"},
+                             {"specimen", {{"file", spec}}},
+                             {"loading", {{"jaws", "curved"}}},
+                             {"output", {{"vtk", false}, {"plots", false}}}},
+                            scratch("bz_curved"));
+  const nlohmann::json& r = cj.results;
+  EXPECT_EQ(flat.results["jaws"]["shape"], "flat");
+  ASSERT_EQ(r["jaws"]["shape"], "curved") << r.dump(1);
+  // ISRM (1978): jaws of 1.5 times the disk's radius.
+  EXPECT_TRUE(test::near_rel(r["jaws"]["radius_m"].get<double>(),
+                             0.75 * r["specimen"]["diameter_m"].get<double>(), 1e-12));
+  EXPECT_TRUE(r["split"]["found"].get<bool>()) << r["stop_reason"];
+  const double bts = r["tensile_strength_Pa"].get<double>();
+  const double bts_flat = flat.results["tensile_strength_Pa"].get<double>();
+  EXPECT_GT(bts, 0.5 * bts_flat);
+  EXPECT_LT(bts, 2.0 * bts_flat);
+  EXPECT_EQ(r["platen_reseats"].get<int>(), 0);
+}
+
+TEST(Lab, ABrazilianDiskThatLosesItsPlatenGrainsIsReseatedAndSplits) {
+  // The fifth 2D acceptance run's seed 3: a grain sticking out of the cut disk carried the whole
+  // platen load; when its bonds broke it slid aside, the load fell to nothing, and the test
+  // ended without a split. Here every grain touching the top platen is taken away at a third of
+  // the disk's strength: the platens must close again and load the disk to its split.
+  const LabSummary& flat = flat_disk_run();
+  const double bts_flat = flat.results["tensile_strength_Pa"].get<double>();
+  const std::string spec = (test::scratch_root() / "bz_flat" / "specimen.rlspec").string();
+  const Protocol p = load_protocol(protocol(
+      "bz_reseat",
+      {{"test", "brazilian"}, {"specimen", {{"file", spec}}}, {"output", {{"vtk", false}}}}));
+  nlohmann::json meta;
+  std::unique_ptr<Model> m = load_model(spec, &meta);
+  std::unique_ptr<LabProtocol> kind = make_lab_protocol("brazilian");
+  auto* test = dynamic_cast<FrameTest*>(kind.get());
+  ASSERT_NE(test, nullptr);
+  LoadingFrame f(p, *test, *m, meta);
+  f.setup();
+  while (!f.done() && !(f.loading() && f.current().load > bts_flat / 3))
+    f.advance();
+  ASSERT_FALSE(f.done());
+  std::size_t top = m->walls.size();
+  for (std::size_t w = 0; w < m->walls.size(); ++w)
+    if (m->walls[w].name == "platen.top")
+      top = w;
+  ASSERT_LT(top, m->walls.size());
+  std::vector<bool> under(m->balls.size(), false);
+  for (std::size_t ci = 0; ci < m->contacts().size(); ++ci) {
+    const Contact& c = m->contacts()[ci];
+    if (c.kind == ContactKind::BallFacet && static_cast<std::size_t>(c.end2) == top &&
+        m->contact_outputs()[ci].force != Vec3::Zero())
+      under[static_cast<std::size_t>(c.end1)] = true;
+  }
+  ASSERT_GT(std::count(under.begin(), under.end(), true), 0);
+  m->remove_balls(under);
+  const double before = f.current().load;
+  for (int i = 0; i < 20'000'000 && !f.done(); ++i)
+    f.advance();
+  ASSERT_TRUE(f.done());
+  const nlohmann::json r = f.results();
+  EXPECT_GE(r["platen_reseats"].get<int>(), 1) << r["stop_reason"];
+  EXPECT_TRUE(r["split"]["found"].get<bool>()) << r["stop_reason"];
+  EXPECT_NE(r["stop_reason"].get<std::string>().find("split"), std::string::npos);
+  ASSERT_TRUE(r["tensile_strength_Pa"].is_number());
+  EXPECT_GE(r["tensile_strength_Pa"].get<double>(), before);
+}
+
 TEST(Lab, BrazilianStrengthIsTheLoadBeforeTheSplitNotTheHalvesLoadedAfterIt) {
   SpecimenGeometry g;
   g.dim = 2, g.diametral = true;
@@ -529,7 +614,19 @@ TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
       {{{"test", "ucs"}, {"specimen", {{"file", "/nonexistent.rlspec"}}}}, "does not exist"},
       {{{"test", "triaxial"}, {"specimen", {{"file", spec}}}}, "key 'loading.confinement'"},
       {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"colour", 1}}, "unknown key 'colour'"},
-      {{{"test", "brazilian"}, {"specimen", {{"file", spec}}}}, "needs a disk specimen"}};
+      {{{"test", "brazilian"}, {"specimen", {{"file", spec}}}}, "needs a disk specimen"},
+      {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"jaws", "curved"}}}},
+       "curved jaws load Brazilian disks only"},
+      {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"jaws", "round"}}}},
+       "key 'loading.jaws'"},
+      {{{"test", "brazilian"},
+        {"specimen", {{"file", spec}}},
+        {"loading", {{"jaws", "curved"}, {"jaw_radius_ratio", 1.0}}}},
+       "key 'loading.jaw_radius_ratio'"},
+      {{{"test", "brazilian"},
+        {"specimen", {{"file", spec}}},
+        {"loading", {{"jaw_radius_ratio", 2.0}}}},
+       "applies to \"jaws\": \"curved\" only"}};
   for (const Case& k : cases) {
     const std::string file = protocol("bad", k.j);
     const fs::path out = scratch("bad_out");

@@ -73,7 +73,7 @@ struct Outcome {
 /// Evaluations per stage at most; polish: each of stages 1 and 2 again after stage 3. The
 /// defaults add up to at most 36 with the final evaluation.
 struct Budget {
-  int elastic = 6, strength = 4, ratios = 20, polish = 2;
+  int elastic = 6, strength = 4, ratios = 20, polish = 3;
   bool sensitivity = true; ///< afterwards, one single-seed run per parameter (the report's table)
 };
 

@@ -94,7 +94,7 @@ void LoadingFrame::control() {
   // dilating specimen is followed without a standing error), plus a proportional term that
   // closes the whole stress error in one step and a small integral trim (time constant 100 steps,
   // limited to 5 % of the confinement) against any remaining bias.
-  if (!lateral_.empty() || phase_ == kConfine || phase_ == kSeat)
+  if (!lateral_.empty() || phase_ == kConfine || phase_ == kSeat || reseating_)
     gather_wall_sums();
   if (servo_integral_.size() != lateral_.size())
     servo_integral_.assign(lateral_.size(), 0.0);
@@ -113,13 +113,13 @@ void LoadingFrame::control() {
       w.velocity = -lateral_sign_[k] * v * unit(lateral_axis_[k]);
   }
   double v = 0;
-  if (phase_ == kConfine || phase_ == kSeat) {
+  if (phase_ == kConfine || phase_ == kSeat || (phase_ == kLoad && reseating_)) {
     const double target = phase_ == kConfine ? p_.confinement : p_.seating_stress;
     v = servo_velocity(static_cast<std::size_t>(top_), target, current_area(0),
                        current_.axial_stress);
   } else if (phase_ == kLoad) {
     // Smooth start (PFC ramps the platen velocity too): no stress wave from a sudden jolt.
-    const double ramp = p_.ramp_steps > 0 ? static_cast<double>(m_.step() - load_start_step_) /
+    const double ramp = p_.ramp_steps > 0 ? static_cast<double>(m_.step() - ramp_start_step_) /
                                                 static_cast<double>(p_.ramp_steps)
                                           : 1.0;
     v = v_final_ * smoothstep(ramp);

@@ -85,7 +85,7 @@ const char* LoadingFrame::phase_name() const {
 
 void LoadingFrame::begin_loading() {
   phase_ = kLoad;
-  load_start_step_ = phase_start_step_ = m_.step();
+  load_start_step_ = phase_start_step_ = ramp_start_step_ = m_.step();
   energy_load_ = ledger_values(m_.energy());
   sep_ref_ = separation();
   shell_ref_.clear();
@@ -202,6 +202,16 @@ void LoadingFrame::advance() {
     return;
   }
   // Loading or unloading.
+  const std::int64_t reseat_for = m_.step() - reseat_step_;
+  if (reseating_ && reseat_for >= 200 && reseat_for % 100 == 0 &&
+      std::abs(current_.axial_stress - p_.seating_stress) <= 0.1 * p_.seating_stress &&
+      m_.mean_unbalanced_force_ratio() <= 1e-2) {
+    reseating_ = false; // seated again (as the seating phase): load on after the ramp
+    ramp_start_step_ = m_.step();
+    reload_peak_ = current_.load;
+    reload_strain0_ = current_.axial_strain;
+  }
+  reload_peak_ = std::max(reload_peak_, current_.load);
   const std::int64_t loading = m_.step() - load_start_step_;
   const std::int64_t fine = std::max<std::int64_t>(1, p_.history_every / 10);
   if (loading % fine == 0)
@@ -218,6 +228,15 @@ void LoadingFrame::advance() {
   if (loading % p_.history_every == 0)
     record_history();
   stop_rules();
+}
+
+void LoadingFrame::reseat() {
+  if (top_ < 0 || phase_ != kLoad || reseating_)
+    return;
+  reseating_ = true;
+  reseat_step_ = m_.step();
+  ++reseats_;
+  record_history();
 }
 
 void LoadingFrame::track_peak() {
@@ -271,6 +290,9 @@ template <class A> void LoadingFrame::fields(A& a) {
   a.object("geometry", geo_);
   a("phase", phase_), a("phase_start_step", phase_start_step_);
   a("load_start_step", load_start_step_), a("reverse_step", reverse_step_);
+  a("ramp_start_step", ramp_start_step_), a("reseating", reseating_), a("reseats", reseats_);
+  a("reseat_step", reseat_step_);
+  a("reload_peak", reload_peak_), a("reload_strain0", reload_strain0_);
   a("top", top_), a("bottom", bottom_), a("lateral", lateral_), a("lateral_axis", lateral_axis_);
   a("lateral_sign", lateral_sign_), a("grip_top", grip_top_), a("grip_bottom", grip_bottom_);
   a("shell", shell_), a("v_final", v_final_), a("sep_ref", sep_ref_), a("shell_ref", shell_ref_);

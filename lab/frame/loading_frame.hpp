@@ -141,6 +141,15 @@ public:
   bool confined() const { return !lateral_.empty(); }
   const ConfinementBand& confinement_band() const { return band_; }
   bool loading() const { return phase_ >= kLoad; }
+  /// The platens lost the specimen while loading (a grain under a platen gave way and the load
+  /// collapsed): they close again with the seating servo to the seating stress, then load on at
+  /// the test's rate after the usual ramp. The peak and the curve so far stand.
+  void reseat();
+  bool reseating() const { return reseating_; }
+  int reseats() const { return reseats_; }
+  /// Since the last re-seating ended: the largest load [Pa] and the axial strain [-] travelled.
+  double reload_peak() const { return reload_peak_; }
+  double reload_strain() const { return current_.axial_strain - reload_strain0_; }
   /// The current cross-section [m^2] (confined: the walls'; else widened by the lateral strain).
   double current_area(double lateral_strain) const;
 
@@ -159,6 +168,7 @@ private:
   LinearProps platen_contact(bool friction) const;
   std::int64_t add_wall(Wall w, const LinearProps& props);
   void add_platens(const LinearProps& props);
+  Wall curved_jaw(const std::string& name, int side) const;
   void add_grips();
   void add_confinement(const LinearProps& props);
   void find_shell();
@@ -199,8 +209,14 @@ private:
   // state
   int phase_ = kSeat;
   std::int64_t phase_start_step_ = 0, load_start_step_ = 0, reverse_step_ = -1;
-  double v_final_ = 0; ///< platen (grip) speed while loading [m/s]
-  double sep_ref_ = 0; ///< platen or grip separation when loading began [m]
+  std::int64_t ramp_start_step_ = 0; ///< the loading ramp's start (loading, or a re-seating's end)
+  bool reseating_ = false;           ///< closing again to the seating stress while loading
+  std::int64_t reseat_step_ = 0;     ///< the step the last re-seating began
+  int reseats_ = 0;                  ///< re-seatings so far
+  double reload_peak_ = 0;           ///< largest load since the last re-seating ended [Pa]
+  double reload_strain0_ = 0;        ///< axial strain when the last re-seating ended [-]
+  double v_final_ = 0;               ///< platen (grip) speed while loading [m/s]
+  double sep_ref_ = 0;               ///< platen or grip separation when loading began [m]
   std::vector<Vec3> shell_ref_;
   Vec3 lateral_ref_ = Vec3::Zero(); ///< wall widths (cylinder radius in [0]) when loading began
   double load_ref_ = 0;             ///< load when loading began (the seating stress)

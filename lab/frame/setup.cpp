@@ -137,8 +137,36 @@ void LoadingFrame::add_platens(const LinearProps& props) {
   Vec3 ptop = g.center, pbot = g.center;
   ptop[g.axis] = g.hi[g.axis];
   pbot[g.axis] = g.lo[g.axis];
+  if (g.diametral && p_.jaw_radius_ratio > 0) {
+    top_ = add_wall(curved_jaw("platen.top", 1), props);
+    bottom_ = add_wall(curved_jaw("platen.bottom", -1), props);
+    return;
+  }
   top_ = add_wall(machine_wall(g.dim, "platen.top", ptop, -e, span), props);
   bottom_ = add_wall(machine_wall(g.dim, "platen.bottom", pbot, e, span), props);
+}
+
+// An ISRM curved jaw (ISRM 1978: radius 1.5 times the disk's) as the machine's exact circle (2D)
+// or cylinder along the disk's axis z (3D): the disk lies inside it, touching it only near the
+// loaded end of its diameter (0.38 R of clearance at the disk's equator for a ratio of 1.5). Its
+// centre is on the loaded diameter, placed so that the circle just clears every grain.
+Wall LoadingFrame::curved_jaw(const std::string& name, int side) const {
+  const SpecimenGeometry& g = geo_;
+  const double rj = p_.jaw_radius_ratio * 0.5 * g.width0.x(); // D as in 2F / (pi D t)
+  double yc = side > 0 ? -1e300 : 1e300; // top: the lowest centre that clears; bottom: highest
+  for (std::size_t i = 0; i < m_.balls.size(); ++i) {
+    const double dx = m_.balls.pos[i].x() - g.center.x(), reach = rj - m_.balls.radius[i];
+    const double h = std::sqrt(std::max(reach * reach - dx * dx, 0.0));
+    const double y = m_.balls.pos[i].y();
+    yc = side > 0 ? std::max(yc, y - h) : std::min(yc, y + h);
+  }
+  Wall w;
+  w.name = name;
+  w.cylinder_radius = rj;
+  w.center = Vec3(g.center.x(), yc, g.center.z());
+  w.axis = Vec3::UnitZ();
+  w.update_bounds();
+  return w;
 }
 
 void LoadingFrame::add_grips() {

@@ -73,10 +73,13 @@ private:
   std::array<bool, 10> bins_{};
 };
 
+constexpr int kMaxReseats = 3; ///< platen re-seatings after a collapse without a split
+
 class BrazilianTest final : public FrameTest {
 public:
   const char* name() const override { return "brazilian"; }
-  int revision() const override { return 4; } // 2: strength before the split; 4: one bridge
+  // 2: strength before the split; 4: one bridge; 5: re-seating after a collapse without a split
+  int revision() const override { return 5; }
   FrameSetup setup() const override {
     FrameSetup s;
     s.diametral = true;
@@ -100,23 +103,46 @@ public:
     s.axial_stress = 2 * s.force / (std::numbers::pi * g.width0.x() * g.thickness);
     s.load = s.axial_stress;
   }
-  std::string stop_after_drop(const LoadingFrame& f) override {
+  std::string stop_after_drop(LoadingFrame& f) override {
     // A disk can lose load locally (a grain crushed under a platen) and reload; only a split
-    // along the loaded diameter ends the test, or a load collapse below failed_fraction.
+    // along the loaded diameter ends the test, or a load collapse below failed_fraction that
+    // re-seating the platens does not cure.
     const Protocol& p = f.protocol();
     if (p.split_fraction <= 0)
       return load_fell_reason(p);
     if (split_seen(f))
       return "the disk split and the load fell below " + format_double(p.post_peak_fraction) +
              " of its peak";
-    if (f.current().load < p.failed_fraction * f.peak().load)
-      return "the load fell below " + format_double(p.failed_fraction) +
-             " of its peak without a split along the loaded diameter";
-    return "";
+    const double low = p.failed_fraction * f.peak().load;
+    if (f.current().load >= low || f.reseating())
+      return "";
+    // The load collapsed without a split. A grain that sticks out of the cut disk can carry the
+    // whole platen load on one or two bonds; when they break it slides aside and the platen
+    // loads nothing (the fifth 2D acceptance run's seed 3: 5 MPa to 0.05 MPa in 800 steps with
+    // one new crack). The platens close again (at the seating servo's speed, not the test's)
+    // and load on; once reloaded, a new collapse is a new re-seating, at most kMaxReseats.
+    const bool reloaded = f.reseats() == 0 || f.reload_peak() >= low;
+    if (reloaded && f.reseats() < kMaxReseats) {
+      f.reseat();
+      return "";
+    }
+    // Reloading after a re-seating: give it the platen travel the disk needed to its peak.
+    if (!reloaded && f.reload_strain() < f.peak().strain)
+      return "";
+    return "the load fell below " + format_double(p.failed_fraction) +
+           " of its peak without a split along the loaded diameter" +
+           (f.reseats() > 0 ? " (platens re-seated " + std::to_string(f.reseats()) + " times)"
+                            : std::string());
   }
   void results(const LoadingFrame& f, nlohmann::json& r) const override {
     const Protocol& p = f.protocol();
     const PeakRecord& peak = f.peak();
+    r["platen_reseats"] = f.reseats(); // collapses without a split that re-seating cured
+    r["jaws"] =
+        p.jaw_radius_ratio > 0
+            ? nlohmann::json{{"shape", "curved"},
+                             {"radius_m", p.jaw_radius_ratio * 0.5 * f.geometry().width0.x()}}
+            : nlohmann::json{{"shape", "flat"}};
     if (p.split_fraction <= 0) { // the split check is off: the peak, as the user asked
       r["tensile_strength_Pa"] = peak.load;
       r["tensile_strength_method"] = "the peak of 2F/(pi D t) (stop.split_fraction 0)";

@@ -10,6 +10,8 @@ namespace rocklab {
 void FrameTest::check_loading(JsonObject& loading, const Protocol& p) const {
   if (p.confinement > 0)
     loading.fail("confinement", "only a triaxial test is confined (use \"test\": \"triaxial\")");
+  if (p.jaw_radius_ratio > 0 && !setup().diametral)
+    loading.fail("jaws", "curved jaws load Brazilian disks only");
 }
 
 void FrameTest::check_stop(JsonObject& stop) const {
@@ -24,7 +26,7 @@ void FrameTest::check_shape(const std::string& shape, const Protocol& p) const {
                               "cylinder, prism or rectangle");
 }
 
-std::string FrameTest::stop_after_drop(const LoadingFrame& f) {
+std::string FrameTest::stop_after_drop(LoadingFrame& f) {
   return load_fell_reason(f.protocol());
 }
 

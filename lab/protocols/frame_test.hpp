@@ -39,7 +39,7 @@ public:
   virtual void stresses(const LoadingFrame& f, LabSample& s) const = 0;
   /// Called at stop checks once the load fell below stop.post_peak_fraction of its peak: the stop
   /// reason, or "" to go on (default: stop).
-  virtual std::string stop_after_drop(const LoadingFrame& f);
+  virtual std::string stop_after_drop(LoadingFrame& f);
   /// The test's own results (the frame writes the common ones).
   virtual void results(const LoadingFrame& f, nlohmann::json& r) const = 0;
   virtual PlotLabels plot_labels() const = 0;
