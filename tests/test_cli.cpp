@@ -103,6 +103,33 @@ TEST(Cli, WrongType) {
   EXPECT_NE(msg.find("key 'run.cycles': expected an integer"), std::string::npos) << msg;
 }
 
+TEST(Cli, DuplicateKeysHugeNumbersDeepNestingAndDirectoriesAreInputErrors) {
+  // JSON keeps the last of two equal keys silently (a ball given "velocity" twice was taken at
+  // rest); 1e400 and a directory as the input file came out as library text with exit 1; deep
+  // nesting once overflowed the stack.
+  std::string twice = kGoodScene;
+  twice.replace(twice.find("\"density\": 2650"), 15, "\"density\": 2650, \"density\": 3000");
+  std::string huge = kGoodScene;
+  huge.replace(huge.find("\"cycles\": 100"), 13, "\"cycles\": 1e400");
+  const std::string deep = "{\"dimension\": " + std::string(300, '[') + std::string(300, ']') + "}";
+  const fs::path dir = rocklab::test::scratch_root() / "rocklab-scene-dir.json";
+  fs::create_directories(dir);
+  const std::vector<std::pair<fs::path, std::string>> cases{
+      {write_scene("twice", twice), "key 'balls[0].density' appears twice"},
+      {write_scene("huge", huge), "number overflow parsing '1e400'"},
+      {write_scene("deep", deep), "key 'dimension[0][0]"},
+      {dir, "is a directory"}};
+  for (const auto& [scene, message] : cases) {
+    const fs::path out = scratch("badjson");
+    std::string msg;
+    EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string(), &msg), 2)
+        << msg;
+    EXPECT_NE(msg.find(scene.string() + ": "), std::string::npos) << msg;
+    EXPECT_NE(msg.find(message), std::string::npos) << msg;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
 TEST(Cli, MissingFile) {
   const fs::path out = scratch("missing");
   std::string msg;

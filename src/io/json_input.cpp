@@ -1,8 +1,11 @@
 #include "io/json_input.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
+#include <vector>
 
 namespace rocklab {
 
@@ -40,12 +43,86 @@ std::string describe(const nlohmann::json& v) {
   return std::string(v.type_name()) + " " + s;
 }
 
+namespace {
+
+// While parsing: a key given twice in one object (JSON keeps only the last, silently: a ball with
+// "velocity":[1,0],"velocity":[0,0] was taken as at rest) and nesting deeper than any input needs
+// (70,000 levels once overflowed the stack) are input errors naming the key path.
+class KeyCheck {
+public:
+  explicit KeyCheck(const std::string& file) : file_(file) {}
+  bool operator()(int depth, nlohmann::json::parse_event_t ev, nlohmann::json& parsed) {
+    using E = nlohmann::json::parse_event_t;
+    if (depth > kMaxDepth)
+      throw InputError(file_ + ": key '" + where("") + "': nested deeper than " +
+                       std::to_string(kMaxDepth) + " levels");
+    switch (ev) {
+    case E::object_start:
+    case E::array_start:
+      levels_.push_back({element_label(), ev == E::array_start, 0, {}});
+      break;
+    case E::object_end:
+    case E::array_end:
+      if (!levels_.empty())
+        levels_.pop_back();
+      break;
+    case E::key:
+      pending_ = parsed.get<std::string>();
+      if (!levels_.empty() && !levels_.back().keys.insert(pending_).second)
+        throw InputError(file_ + ": key '" + where(pending_) +
+                         "' appears twice in one object (only one may be given)");
+      break;
+    case E::value:
+      element_label();
+      break;
+    }
+    return true;
+  }
+
+private:
+  static constexpr int kMaxDepth = 256;
+  struct Level {
+    std::string label; ///< its key in the parent object, or "[i]" in the parent array
+    bool array = false;
+    int next = 0; ///< arrays: the next element's index
+    std::set<std::string> keys;
+  };
+  // The label of the element starting now (an array's next index, or the pending key).
+  std::string element_label() {
+    if (!levels_.empty() && levels_.back().array)
+      return "[" + std::to_string(levels_.back().next++) + "]";
+    return pending_;
+  }
+  std::string where(const std::string& key) const {
+    std::string s;
+    for (const Level& l : levels_)
+      if (!l.label.empty())
+        s += (s.empty() || l.label[0] == '[' ? "" : ".") + l.label;
+    if (!key.empty())
+      s += (s.empty() ? "" : ".") + key;
+    if (s.size() > 80) // deep nesting: the start says where
+      s = s.substr(0, 77) + "...";
+    return s.empty() ? "<top level>" : s;
+  }
+  const std::string& file_;
+  std::vector<Level> levels_;
+  std::string pending_;
+};
+
+} // namespace
+
 nlohmann::json read_json_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(path + ": is a directory, not a JSON file");
   std::ifstream in(path);
   if (!in)
     throw InputError(path + ": cannot open file (missing or unreadable)");
   try {
-    return nlohmann::json::parse(in, nullptr, true, /*ignore_comments=*/true);
+    return nlohmann::json::parse(in, KeyCheck(path), true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::out_of_range& e) { // a number beyond a double (1e400)
+    throw InputError(path + ": malformed JSON: " + e.what() +
+                     " (numbers must lie within +-1.8e308)");
   } catch (const nlohmann::json::parse_error& e) {
     // e.byte gives the position; report line and column for a person.
     std::ifstream again(path);
