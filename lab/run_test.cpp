@@ -341,10 +341,17 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
     std::printf("peak stress  %.4g MPa (deviator %.4g MPa) at axial strain %.4g %%\n",
                 mpa("peak_stress_Pa"), mpa("peak_deviator_Pa"),
                 100 * r["peak_axial_strain"].get<double>());
-    std::printf("E            %.4g GPa over the linear window, %.4g GPa secant at 50 %% of peak"
-                "   poisson %.3f\n",
-                1e-3 * mpa("youngs_modulus_Pa"), 1e-3 * mpa("youngs_modulus_secant_Pa"),
-                r["poisson_ratio"].get<double>());
+    auto shown = [&](const char* key, const char* fmt, double scale) {
+      if (!r.contains(key) || !r[key].is_number())
+        return std::string("not measured");
+      char b[48];
+      std::snprintf(b, sizeof b, fmt, r[key].get<double>() * scale);
+      return std::string(b);
+    };
+    std::printf("E            %s over the linear window, %s secant at 50 %% of peak   poisson %s\n",
+                shown("youngs_modulus_Pa", "%.4g GPa", 1e-9).c_str(),
+                shown("youngs_modulus_secant_Pa", "%.4g GPa", 1e-9).c_str(),
+                shown("poisson_ratio", "%.3f", 1).c_str());
     auto ratio = [&](const char* key) {
       const nlohmann::json& v = r["crack_stresses"][key];
       return v.is_number() ? v.get<double>() : 0.0;

@@ -304,7 +304,7 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
   for (const auto& entry : fs::directory_iterator(dir / "out"))
     fs::rename(entry.path(), dir / entry.path().filename());
   fs::remove(dir / "out");
-  const nlohmann::json r = read_json_file((dir / "results.json").string());
+  const nlohmann::json r = read_json_file((dir / "results.json").string(), Nulls::Allow);
   row["status"] = "ok";
   row["results"] = "tests/" + t.name + "/results.json";
   const double conf = num(r, "confinement_Pa");

@@ -103,10 +103,10 @@ TEST(Cli, WrongType) {
   EXPECT_NE(msg.find("key 'run.cycles': expected an integer"), std::string::npos) << msg;
 }
 
-TEST(Cli, DuplicateKeysHugeNumbersDeepNestingAndDirectoriesAreInputErrors) {
+TEST(Cli, DuplicateKeysHugeNumbersDeepNestingNullsAndDirectoriesAreInputErrors) {
   // JSON keeps the last of two equal keys silently (a ball given "velocity" twice was taken at
-  // rest); 1e400 and a directory as the input file came out as library text with exit 1; deep
-  // nesting once overflowed the stack.
+  // rest), a null was taken as an absent key; 1e400 and a directory as the input file came out as
+  // library text with exit 1; deep nesting once overflowed the stack.
   std::string twice = kGoodScene;
   twice.replace(twice.find("\"density\": 2650"), 15, "\"density\": 2650, \"density\": 3000");
   std::string huge = kGoodScene;
@@ -118,6 +118,8 @@ TEST(Cli, DuplicateKeysHugeNumbersDeepNestingAndDirectoriesAreInputErrors) {
       {write_scene("twice", twice), "key 'balls[0].density' appears twice"},
       {write_scene("huge", huge), "number overflow parsing '1e400'"},
       {write_scene("deep", deep), "key 'dimension[0][0]"},
+      {write_scene("null", R"({"dimension": 3, "balls": [{"id": 1, "position": [0, null, 0]}]})"),
+       "key 'balls[0].position[1]': null is not a value here"},
       {dir, "is a directory"}};
   for (const auto& [scene, message] : cases) {
     const fs::path out = scratch("badjson");
@@ -167,6 +169,23 @@ TEST(Cli, BlowUpStopsWithAMessage) {
   EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string(), &msg), 3);
   EXPECT_NE(msg.find("physical blow-up"), std::string::npos) << msg;
   EXPECT_NE(msg.find("overlap beyond a radius"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(Cli, ASpinNoStepCanFollowStopsAsABlowUp) {
+  // Two touching balls, one spinning at 1e308 rad/s: the run wrote null energies and exited 0.
+  const std::string text = R"({
+    "dimension": 3,
+    "balls": [{"position": [0, 0, 0], "radius": 0.01, "density": 2650, "spin": [0, 0, 1e308]},
+              {"position": [0.0199, 0, 0], "radius": 0.01, "density": 2650}],
+    "contact_models": [{"between": "ball-ball", "model": "linear", "properties": {"kn": 1e6}}],
+    "run": {"cycles": 100}})";
+  const fs::path scene = write_scene("spin", text);
+  const fs::path out = scratch("spin");
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string(), &msg), 3);
+  EXPECT_NE(msg.find("physical blow-up"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("more than 1 rad"), std::string::npos) << msg;
   EXPECT_FALSE(fs::exists(out));
 }
 

@@ -148,7 +148,7 @@ Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_
     (missing[i] == '1' ? run_ : ev.cached) += 1;
     const fs::path suite_out = reps[i].dir / "suite";
     ev.folders.push_back(suite_out.string());
-    const nlohmann::json sm = read_json_file((suite_out / "summary.json").string());
+    const nlohmann::json sm = read_json_file((suite_out / "summary.json").string(), Nulls::Allow);
     check_tests(sm, suite_out, reps[i].tests);
     for (const auto& [k, v] : sm["properties"].items())
       all[k].push_back(v.is_number() ? v.get<double>() : std::nan(""));

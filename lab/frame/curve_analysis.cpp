@@ -136,7 +136,9 @@ CurveAnalysis analyse_curve(const CurveInput& in) {
 }
 
 void write_curve_results(const CurveAnalysis& a, double peak, nlohmann::json& r) {
-  r["youngs_modulus_Pa"] = a.youngs_modulus;
+  // Not positive: no elastic loading branch (warned); never reported as a modulus of 0.
+  r["youngs_modulus_Pa"] =
+      a.youngs_modulus > 0 ? nlohmann::json(a.youngs_modulus) : nlohmann::json(nullptr);
   r["poisson_ratio"] = a.poisson_ratio;
   r["youngs_modulus_secant_Pa"] = a.secant50;
   r["youngs_modulus_tangent50_Pa"] = a.tangent50;

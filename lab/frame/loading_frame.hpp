@@ -76,10 +76,12 @@ struct SpecimenGeometry {
 struct PeakRecord {
   double load = 0, strain = 0, stress = 0, force = 0, lateral = 0, time = 0;
   std::int64_t step = -1, tension = 0, shear = 0; ///< step and crack counts at the peak
+  /// At the peak, |F_top + F_bottom| / (|F_top| + |F_bottom|) of the platens (-1: grips).
+  double imbalance = -1;
   template <class A> void fields(A& a) {
     a("load", load), a("strain", strain), a("stress", stress), a("force", force);
     a("lateral", lateral), a("time", time), a("step", step), a("tension", tension);
-    a("shear", shear);
+    a("shear", shear), a("imbalance", imbalance);
   }
 };
 
@@ -189,6 +191,7 @@ private:
   void record_history();
   void mark_energy_start();
   void energy_results(nlohmann::json& r) const;
+  void quasi_static_results(nlohmann::json& r) const;
   void begin_loading();
   void finish(const std::string& why);
   void track_peak();

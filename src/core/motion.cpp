@@ -154,9 +154,12 @@ void Model::track_motion(double dt) {
               : bad) if (n >= kParallelMin)
   for (std::size_t i = 0; i < n; ++i) {
     vmax = std::max(vmax, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
-    step_ratio = std::max(step_ratio, balls.vel[i].norm() * dt / balls.radius[i]);
+    // A ball that moves more than its radius or turns more than a radian in one step.
+    step_ratio = std::max(
+        {step_ratio, balls.vel[i].norm() * dt / balls.radius[i], balls.spin[i].norm() * dt});
     dmax = std::max(dmax, balls.disp[i].norm());
-    bad = bad || !balls.pos[i].allFinite() || !balls.vel[i].allFinite();
+    bad =
+        bad || !balls.pos[i].allFinite() || !balls.vel[i].allFinite() || !balls.spin[i].allFinite();
   }
   max_speed_ = vmax;
   max_ball_disp_ = dmax;
@@ -170,14 +173,20 @@ void Model::track_motion(double dt) {
             << " m in one step, more than its radius " << balls.radius[i]
             << " m; reduce the time step";
         throw PhysicsError(msg.str());
+      } else if (balls.spin[i].norm() * dt > 1) {
+        std::ostringstream msg;
+        msg << "physical blow-up at step " << step_ << " (t = " << time_ << " s): ball id "
+            << balls.id[i] << " turned " << balls.spin[i].norm() * dt << " rad in one step (spin "
+            << balls.spin[i].norm() << " rad/s), more than 1 rad; reduce the time step or the spin";
+        throw PhysicsError(msg.str());
       }
   }
   if (bad) {
     for (std::size_t i = 0; i < n; ++i)
-      if (!balls.pos[i].allFinite() || !balls.vel[i].allFinite()) {
+      if (!balls.pos[i].allFinite() || !balls.vel[i].allFinite() || !balls.spin[i].allFinite()) {
         std::ostringstream msg;
         msg << "physical blow-up at step " << step_ << " (t = " << time_ << " s): ball id "
-            << balls.id[i] << " has a non-finite position or velocity; reduce the time step";
+            << balls.id[i] << " has a non-finite position, velocity or spin; reduce the time step";
         throw PhysicsError(msg.str());
       }
   }

@@ -50,7 +50,7 @@ namespace {
 // (70,000 levels once overflowed the stack) are input errors naming the key path.
 class KeyCheck {
 public:
-  explicit KeyCheck(const std::string& file) : file_(file) {}
+  KeyCheck(const std::string& file, Nulls nulls) : file_(file), nulls_(nulls) {}
   bool operator()(int depth, nlohmann::json::parse_event_t ev, nlohmann::json& parsed) {
     using E = nlohmann::json::parse_event_t;
     if (depth > kMaxDepth)
@@ -72,9 +72,13 @@ public:
         throw InputError(file_ + ": key '" + where(pending_) +
                          "' appears twice in one object (only one may be given)");
       break;
-    case E::value:
-      element_label();
+    case E::value: {
+      const std::string label = element_label();
+      if (parsed.is_null() && nulls_ == Nulls::Reject) // "shape": null was taken as no shape
+        throw InputError(file_ + ": key '" + where(label) +
+                         "': null is not a value here (leave the key out for its default)");
       break;
+    }
     }
     return true;
   }
@@ -99,19 +103,20 @@ private:
       if (!l.label.empty())
         s += (s.empty() || l.label[0] == '[' ? "" : ".") + l.label;
     if (!key.empty())
-      s += (s.empty() ? "" : ".") + key;
+      s += (s.empty() || key[0] == '[' ? "" : ".") + key;
     if (s.size() > 80) // deep nesting: the start says where
       s = s.substr(0, 77) + "...";
     return s.empty() ? "<top level>" : s;
   }
   const std::string& file_;
+  Nulls nulls_;
   std::vector<Level> levels_;
   std::string pending_;
 };
 
 } // namespace
 
-nlohmann::json read_json_file(const std::string& path) {
+nlohmann::json read_json_file(const std::string& path, Nulls nulls) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw InputError(path + ": is a directory, not a JSON file");
@@ -119,7 +124,7 @@ nlohmann::json read_json_file(const std::string& path) {
   if (!in)
     throw InputError(path + ": cannot open file (missing or unreadable)");
   try {
-    return nlohmann::json::parse(in, KeyCheck(path), true, /*ignore_comments=*/true);
+    return nlohmann::json::parse(in, KeyCheck(path, nulls), true, /*ignore_comments=*/true);
   } catch (const nlohmann::json::out_of_range& e) { // a number beyond a double (1e400)
     throw InputError(path + ": malformed JSON: " + e.what() +
                      " (numbers must lie within +-1.8e308)");

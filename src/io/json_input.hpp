@@ -32,8 +32,11 @@ struct Range {
   static Range half_open(double a, double b) { return {a, b, false, true}; }
 };
 
-/// Parse a JSON file; syntax errors name the file, line and column.
-nlohmann::json read_json_file(const std::string& path);
+/// Parse a JSON file; syntax errors name the file, line and column. A key given twice in one
+/// object, nesting deeper than 256 levels and (in input files, not in rocklab's own outputs read
+/// back) a null value are input errors naming the key path.
+enum class Nulls { Reject, Allow };
+nlohmann::json read_json_file(const std::string& path, Nulls nulls = Nulls::Reject);
 
 /// A JSON object being read: tracks the keys used so unknown keys can be reported.
 class JsonObject {
