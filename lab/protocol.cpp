@@ -45,6 +45,10 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
       p.material_file = resolve(file, s.string("material"));
       if (!std::filesystem::exists(p.material_file))
         s.fail("material", "\"" + p.material_file + "\" does not exist");
+      if (std::filesystem::is_directory(p.material_file) ||
+          std::filesystem::is_character_file(p.material_file) ||
+          std::filesystem::is_block_file(p.material_file))
+        s.fail("material", "\"" + p.material_file + "\" is not a material card file");
       if (s.has("shape"))
         p.shape = s.raw("shape");
       if (s.has("cut"))
@@ -104,10 +108,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
 Protocol load_protocol(const std::string& path) {
   const nlohmann::json j = read_json_file(path);
   Protocol p = protocol_from_json(j, path, "");
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  p.text_hash = text_hash(ss.str());
+  p.text_hash = text_hash(read_input_text(path));
   return p;
 }
 

@@ -25,13 +25,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 bool valid_name(const std::string& s) {
   if (s.empty() || s.size() > 64)
     return false;
@@ -101,7 +94,7 @@ Suite load_suite(const std::string& path) {
   Suite s;
   s.file = path;
   const nlohmann::json j = read_json_file(path);
-  s.text_hash = text_hash(read_text(path));
+  s.text_hash = text_hash(read_input_text(path));
   JsonObject top(j, path, "");
   if (top.has("units") && top.string("units") != "SI")
     top.fail("units", "only \"SI\" is supported");
@@ -164,7 +157,7 @@ Suite load_suite(const std::string& path) {
 namespace {
 
 std::string last_lines(const std::string& file, int n) {
-  const std::string t = read_text(file);
+  const std::string t = read_input_text(file);
   std::size_t pos = t.size();
   for (int k = 0; k <= n && pos > 0; ++k)
     pos = t.rfind('\n', pos - 1);

@@ -319,12 +319,7 @@ void read_joints(JsonObject& top, MaterialCard& c, const std::string& path) {
 MaterialCard load_material_card(const std::string& path) {
   MaterialCard c;
   c.file = path;
-  {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    c.text_hash = text_hash(ss.str());
-  }
+  c.text_hash = text_hash(read_input_text(path));
   c.raw = read_json_file(path);
   JsonObject top(c.raw, path, "");
   if (top.has("units") && top.string("units") != "SI")

@@ -120,7 +120,8 @@ TEST(Cli, DuplicateKeysHugeNumbersDeepNestingNullsAndDirectoriesAreInputErrors) 
       {write_scene("deep", deep), "key 'dimension[0][0]"},
       {write_scene("null", R"({"dimension": 3, "balls": [{"id": 1, "position": [0, null, 0]}]})"),
        "key 'balls[0].position[1]': null is not a value here"},
-      {dir, "is a directory"}};
+      {dir, "is a directory, not an input file"},
+      {"/dev/zero", "is a device or socket, not an input file"}};
   for (const auto& [scene, message] : cases) {
     const fs::path out = scratch("badjson");
     std::string msg;

@@ -641,6 +641,8 @@ TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
       {{{"test", "triaxial"}, {"specimen", {{"file", spec}}}}, "key 'loading.confinement'"},
       {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"colour", 1}}, "unknown key 'colour'"},
       {{{"test", "brazilian"}, {"specimen", {{"file", spec}}}}, "needs a disk specimen"},
+      {{{"test", "ucs"}, {"specimen", {{"material", "/dev/zero"}}}},
+       "key 'specimen.material': \"/dev/zero\" is not a material card file"},
       {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"jaws", "curved"}}}},
        "curved jaws load Brazilian disks only"},
       {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"jaws", "round"}}}},

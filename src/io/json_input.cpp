@@ -116,22 +116,32 @@ private:
 
 } // namespace
 
-nlohmann::json read_json_file(const std::string& path, Nulls nulls) {
+std::string read_input_text(const std::string& path) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    throw InputError(path + ": is a directory, not a JSON file");
-  std::ifstream in(path);
+  const auto type = std::filesystem::status(path, ec).type();
+  if (type == std::filesystem::file_type::directory)
+    throw InputError(path + ": is a directory, not an input file");
+  // A device never ends (/dev/zero was read until memory ran out); a pipe may be given.
+  if (type == std::filesystem::file_type::character || type == std::filesystem::file_type::block ||
+      type == std::filesystem::file_type::socket)
+    throw InputError(path + ": is a device or socket, not an input file");
+  std::ifstream in(path, std::ios::binary);
   if (!in)
     throw InputError(path + ": cannot open file (missing or unreadable)");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+nlohmann::json read_json_file(const std::string& path, Nulls nulls) {
+  const std::string text = read_input_text(path);
   try {
-    return nlohmann::json::parse(in, KeyCheck(path, nulls), true, /*ignore_comments=*/true);
+    return nlohmann::json::parse(text, KeyCheck(path, nulls), true, /*ignore_comments=*/true);
   } catch (const nlohmann::json::out_of_range& e) { // a number beyond a double (1e400)
     throw InputError(path + ": malformed JSON: " + e.what() +
                      " (numbers must lie within +-1.8e308)");
   } catch (const nlohmann::json::parse_error& e) {
     // e.byte gives the position; report line and column for a person.
-    std::ifstream again(path);
-    std::string text((std::istreambuf_iterator<char>(again)), std::istreambuf_iterator<char>());
     std::size_t line = 1, col = 1;
     for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
       if (text[i] == '\n') {
