@@ -102,7 +102,7 @@ struct Campaign {
 
   void elastic(int budget);
   void strength(int budget);
-  void ratios(int budget, bool polish);
+  void ratios(int budget);
 };
 
 // Stage 1. E: the moduli times target/measured. nu: a secant search on log(stiffness ratio),
@@ -162,21 +162,16 @@ void Campaign::strength(int budget) {
 // Stage 3: the scale-free targets (every target but E and the UCS; a stress target X becomes
 // X / UCS against its target / the UCS target) by BOBYQA over the shape parameters, in [0, 1]
 // coordinates (logarithmic for positive bounds). The best evaluated point is kept, never a model
-// prediction; the search stops early once every scale-free target is met. nu is left out when a
-// stiffness ratio is free and a polish follows: the stiffness ratio sets it, and the shape
-// parameters that move it too (slits: 0.2 -> 0.275 took the 2D granite's nu from 0.25 to 0.30)
-// would otherwise be traded against the strength ratios, which nothing else can fix.
-void Campaign::ratios(int budget, bool polish) {
+// prediction; the search stops early once every scale-free target is met.
+void Campaign::ratios(int budget) {
   std::vector<std::size_t> shape;
   for (std::size_t i = 0; i < p.size(); ++i)
     if (p[i].role == Role::Shape)
       shape.push_back(i);
   const Target* tu = target(kUcs);
   std::vector<const Target*> free;
-  const bool nu_elsewhere = polish && has(Role::StiffnessRatio);
   for (const Target& t : targets)
-    if (t.property != kYoungs && t.property != kUcs && (!is_stress(t.property) || tu) &&
-        !(nu_elsewhere && t.property == kPoisson))
+    if (t.property != kYoungs && t.property != kUcs && (!is_stress(t.property) || tu))
       free.push_back(&t);
   if (shape.empty() || free.empty() || budget < 1)
     return;
@@ -271,7 +266,7 @@ Outcome calibrate(std::vector<Param> params, const std::vector<Target>& targets,
   Campaign c{params, targets, evaluate, out};
   c.elastic(budget.elastic);
   c.strength(budget.strength);
-  c.ratios(budget.ratios, budget.polish > 0);
+  c.ratios(budget.ratios);
   // The ratios moved the strengths and moduli a little: scale them back, then measure everything.
   c.elastic(budget.polish);
   c.strength(budget.polish);
