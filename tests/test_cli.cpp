@@ -190,6 +190,37 @@ TEST(Cli, ASpinNoStepCanFollowStopsAsABlowUp) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST(Cli, TheFlatJointBondMethodKeepsToItsGapFilter) {
+  // Issue 16: the flat joint's (and contact bond's) bond method bonded every contact whatever its
+  // gap (88 extra bonds on a 9,896-grain packing). Two balls 1 um apart, unbonded at creation,
+  // pulled apart after the method: bonded, the joint's elements carry the pull (strain energy).
+  auto strain = [&](const std::string& name, const std::string& gap) {
+    const std::string text = R"({"dimension": 2, "local_damping": 0.7, "timestep": 1e-7,
+      "balls": [{"id": 1, "position": [0, 0], "radius": 0.00625, "density": 2650, "fix": "all"},
+                {"id": 2, "position": [0.012501, 0], "radius": 0.00625, "density": 2650,
+                 "fix": "all"}],
+      "contact_models": [{"between": "ball-ball", "model": "flatjoint", "properties": {
+        "fj_Nr": 2, "fj_rmul": 0.8, "fj_kn": 2e12, "fj_ks": 1e12, "fj_ten": 1e20, "fj_coh": 1e20,
+        "bond": false}}],
+      "history": {"every": 10, "columns": ["energy/strain"]},
+      "run": [{"cycles": 1},
+              {"cycles": 1, "methods": [{"model": "flatjoint", "method": "bond")" +
+                             gap + R"(}]},
+              {"cycles": 50, "set": [{"ball": 2, "velocity": [0.01, 0]}]}]})";
+    const fs::path scene = write_scene(name, text);
+    const fs::path out = scratch(name);
+    std::string msg;
+    EXPECT_EQ(
+        run_command(binary() + " run " + scene.string() + " -o " + out.string() + " -q", &msg), 0)
+        << msg;
+    const std::string h = read_file(out / "history.csv");
+    const std::string last = h.substr(h.rfind('\n', h.size() - 2) + 1);
+    return std::stod(last.substr(last.rfind(',') + 1));
+  };
+  EXPECT_EQ(strain("fjgap-default", ""), 0.0); // gap 1 um > 0: not bonded
+  EXPECT_GT(strain("fjgap-wide", R"(, "gap": [-1, 1e-5])"), 0.0);
+}
+
 TEST(Cli, TooLargeFixedStepStopsWithAMessage) {
   // With a fixed step of 1 ms a ball at 50 m/s would jump through the floor unseen.
   const std::string text = R"({

@@ -93,7 +93,8 @@ struct ContactBond {
   }
   static constexpr std::string_view methods[] = {"bond", "unbond"};
   static void call(Contact& c, const MethodArgs& m) {
-    c.state = m.name == "bond" ? BondState::Bonded : BondState::None;
+    if (m.gap >= m.gap_lo && m.gap <= m.gap_hi) // the method's gap filter
+      c.state = m.name == "bond" ? BondState::Bonded : BondState::None;
   }
   static Props read(JsonObject& p, int dim);
   static nlohmann::json state_json(const Contact& c, int dim);

@@ -395,6 +395,8 @@ void FlatJoint::call(Contact& c, Elements e, const MethodArgs& m) {
                                 std::to_string(e.size()) + "]");
   const auto part = m.element > 0 ? e.subspan(static_cast<std::size_t>(m.element - 1), 1) : e;
   const std::size_t first = m.element > 0 ? static_cast<std::size_t>(m.element - 1) : 0;
+  if (m.gap < m.gap_lo || m.gap > m.gap_hi) // the method's gap filter, as for the other models
+    return;
   if (m.name == "bond")
     flatjoint::bond(c, part, first);
   else
