@@ -45,9 +45,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
       p.material_file = resolve(file, s.string("material"));
       if (!std::filesystem::exists(p.material_file))
         s.fail("material", "\"" + p.material_file + "\" does not exist");
-      if (std::filesystem::is_directory(p.material_file) ||
-          std::filesystem::is_character_file(p.material_file) ||
-          std::filesystem::is_block_file(p.material_file))
+      if (!not_an_input_file(p.material_file).empty())
         s.fail("material", "\"" + p.material_file + "\" is not a material card file");
       if (s.has("shape"))
         p.shape = s.raw("shape");

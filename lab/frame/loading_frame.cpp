@@ -186,10 +186,7 @@ void LoadingFrame::advance() {
     // within its band and the specimen is at rest.
     const double target = phase_ == kConfine ? p_.confinement : p_.seating_stress;
     const double tol = phase_ == kConfine ? p_.confinement_tolerance : 0.1;
-    bool ok = std::abs(current_.axial_stress - target) <= tol * target;
-    for (std::size_t k = 0; k < lateral_.size(); ++k)
-      ok = ok && std::abs(lateral_stress_of(k) - target) <= tol * target;
-    if (since % 100 == 0 && ok && since >= 200 && m_.mean_unbalanced_force_ratio() <= 1e-2) {
+    if (servoed_to(target, tol, since)) {
       record_history();
       begin_loading();
     } else if (since > p_.max_steps) {
@@ -202,10 +199,7 @@ void LoadingFrame::advance() {
     return;
   }
   // Loading or unloading.
-  const std::int64_t reseat_for = m_.step() - reseat_step_;
-  if (reseating_ && reseat_for >= 200 && reseat_for % 100 == 0 &&
-      std::abs(current_.axial_stress - p_.seating_stress) <= 0.1 * p_.seating_stress &&
-      m_.mean_unbalanced_force_ratio() <= 1e-2) {
+  if (reseating_ && servoed_to(p_.seating_stress, 0.1, m_.step() - reseat_step_)) {
     reseating_ = false; // seated again (as the seating phase): load on after the ramp
     ramp_start_step_ = m_.step();
     reload_peak_ = current_.load;
@@ -228,6 +222,17 @@ void LoadingFrame::advance() {
   if (loading % p_.history_every == 0)
     record_history();
   stop_rules();
+}
+
+// The seating (and confining) phase's rule, also for the end of a re-seating: checked every 100
+// steps from step 200 of the phase on, every wall within tol of its target and the grains at rest.
+bool LoadingFrame::servoed_to(double target, double tol, std::int64_t since) const {
+  if (since % 100 != 0 || since < 200)
+    return false;
+  bool ok = std::abs(current_.axial_stress - target) <= tol * target;
+  for (std::size_t k = 0; k < lateral_.size(); ++k)
+    ok = ok && std::abs(lateral_stress_of(k) - target) <= tol * target;
+  return ok && m_.mean_unbalanced_force_ratio() <= 1e-2;
 }
 
 void LoadingFrame::reseat() {

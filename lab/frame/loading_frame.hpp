@@ -152,6 +152,8 @@ public:
   /// Since the last re-seating ended: the largest load [Pa] and the axial strain [-] travelled.
   double reload_peak() const { return reload_peak_; }
   double reload_strain() const { return current_.axial_strain - reload_strain0_; }
+  /// Brazilian curved jaws: jaw_radius_ratio times the disk's radius (D as in 2F / (pi D t)) [m].
+  double jaw_radius() const { return p_.jaw_radius_ratio * 0.5 * geo_.width0.x(); }
   /// The current cross-section [m^2] (confined: the walls'; else widened by the lateral strain).
   double current_area(double lateral_strain) const;
 
@@ -193,6 +195,7 @@ private:
   void energy_results(nlohmann::json& r) const;
   void quasi_static_results(nlohmann::json& r) const;
   void begin_loading();
+  bool servoed_to(double target, double tol, std::int64_t since) const;
   void finish(const std::string& why);
   void track_peak();
   bool stop_rules();

@@ -152,7 +152,7 @@ void LoadingFrame::add_platens(const LinearProps& props) {
 // centre is on the loaded diameter, placed so that the circle just clears every grain.
 Wall LoadingFrame::curved_jaw(const std::string& name, int side) const {
   const SpecimenGeometry& g = geo_;
-  const double rj = p_.jaw_radius_ratio * 0.5 * g.width0.x(); // D as in 2F / (pi D t)
+  const double rj = jaw_radius();
   double yc = side > 0 ? -1e300 : 1e300; // top: the lowest centre that clears; bottom: highest
   for (std::size_t i = 0; i < m_.balls.size(); ++i) {
     const double dx = m_.balls.pos[i].x() - g.center.x(), reach = rj - m_.balls.radius[i];

@@ -138,11 +138,9 @@ public:
     const Protocol& p = f.protocol();
     const PeakRecord& peak = f.peak();
     r["platen_reseats"] = f.reseats(); // collapses without a split that re-seating cured
-    r["jaws"] =
-        p.jaw_radius_ratio > 0
-            ? nlohmann::json{{"shape", "curved"},
-                             {"radius_m", p.jaw_radius_ratio * 0.5 * f.geometry().width0.x()}}
-            : nlohmann::json{{"shape", "flat"}};
+    r["jaws"] = p.jaw_radius_ratio > 0
+                    ? nlohmann::json{{"shape", "curved"}, {"radius_m", f.jaw_radius()}}
+                    : nlohmann::json{{"shape", "flat"}};
     if (p.split_fraction <= 0) { // the split check is off: the peak, as the user asked
       r["tensile_strength_Pa"] = peak.load;
       r["tensile_strength_method"] = "the peak of 2F/(pi D t) (stop.split_fraction 0)";

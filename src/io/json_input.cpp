@@ -93,8 +93,12 @@ private:
   };
   // The label of the element starting now (an array's next index, or the pending key).
   std::string element_label() {
-    if (!levels_.empty() && levels_.back().array)
-      return "[" + std::to_string(levels_.back().next++) + "]";
+    if (!levels_.empty() && levels_.back().array) {
+      // Appended, not "[" + ...: GCC 12 warns falsely (-Wrestrict) on that operator+.
+      std::string label(1, '[');
+      label += std::to_string(levels_.back().next++);
+      return label += ']';
+    }
     return pending_;
   }
   std::string where(const std::string& key) const {
@@ -116,15 +120,21 @@ private:
 
 } // namespace
 
-std::string read_input_text(const std::string& path) {
+std::string not_an_input_file(const std::string& path) {
   std::error_code ec;
   const auto type = std::filesystem::status(path, ec).type();
   if (type == std::filesystem::file_type::directory)
-    throw InputError(path + ": is a directory, not an input file");
+    return "is a directory, not an input file";
   // A device never ends (/dev/zero was read until memory ran out); a pipe may be given.
   if (type == std::filesystem::file_type::character || type == std::filesystem::file_type::block ||
       type == std::filesystem::file_type::socket)
-    throw InputError(path + ": is a device or socket, not an input file");
+    return "is a device or socket, not an input file";
+  return "";
+}
+
+std::string read_input_text(const std::string& path) {
+  if (const std::string why = not_an_input_file(path); !why.empty())
+    throw InputError(path + ": " + why);
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw InputError(path + ": cannot open file (missing or unreadable)");

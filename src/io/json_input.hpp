@@ -36,6 +36,8 @@ struct Range {
 /// object, nesting deeper than 256 levels and (in input files, not in rocklab's own outputs read
 /// back) a null value are input errors naming the key path.
 enum class Nulls { Reject, Allow };
+/// Why `path` cannot be an input file (a directory, a device or a socket), or "".
+std::string not_an_input_file(const std::string& path);
 /// The bytes of an input file; a directory, a device or an unreadable file is an input error.
 std::string read_input_text(const std::string& path);
 nlohmann::json read_json_file(const std::string& path, Nulls nulls = Nulls::Reject);
