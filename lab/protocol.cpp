@@ -82,7 +82,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     p.post_peak_fraction = s.number("post_peak_fraction", {0, 1, true, true}, 0.9);
     p.min_steps = s.integer("min_steps", 0, std::numeric_limits<std::int64_t>::max(), 1000);
     p.strain_limit = s.number("strain_limit", Range::non_negative(), 0.0);
-    p.split_fraction = s.number("split_fraction", {0, 1, true, true}, 0.6);
+    p.split_fraction = s.number("split_fraction", Range::closed(0, 1), 0.6);
     p.failed_fraction = s.number("failed_fraction", {0, 1, true, false}, 0.3);
     test->check_stop(s);
     if (p.failed_fraction >= p.post_peak_fraction)

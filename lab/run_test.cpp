@@ -187,12 +187,14 @@ bool FrameRun::loop() {
 }
 
 // The crack-initiation and crack-damage stresses on the axial curve, where results.json has them;
-// a Brazilian test's tensile strength where it is not the peak (taken before the split).
+// a Brazilian test's tensile strength where it is not the peak (taken before the split released
+// the diametral tension).
 std::vector<PlotMarker> crack_markers(const LoadingFrame& f, const nlohmann::json& r) {
   std::vector<PlotMarker> m;
-  if (r.contains("split") && r["split"].contains("stress_Pa"))
+  if (r.contains("split") && r["split"].contains("stress_Pa") &&
+      r["split"]["stress_Pa"] != r["split"]["peak_Pa"])
     m.push_back({100 * r["peak_axial_strain"].get<double>(),
-                 1e-6 * r["tensile_strength_Pa"].get<double>(), "tensile strength (before split)"});
+                 1e-6 * r["tensile_strength_Pa"].get<double>(), "tensile strength (tension lost)"});
   if (!r.contains("crack_stresses"))
     return m;
   const nlohmann::json& c = r["crack_stresses"];
@@ -370,8 +372,10 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
   if (r.contains("tensile_strength_Pa") && r["tensile_strength_Pa"].is_number()) {
     std::printf("tensile strength %.4g MPa (force %.4g N)", mpa("tensile_strength_Pa"),
                 r["peak_force_N"].get<double>());
-    if (r.contains("split") && r["split"]["peak_step"] > r["split"]["step"])
-      std::printf(" before the split; the halves then carried up to %.4g MPa",
+    if (r.contains("split") && r["split"]["tension_lost_step"].get<std::int64_t>() >= 0 &&
+        r["split"]["peak_step"] > r["split"]["tension_lost_step"])
+      std::printf(" before the split released the diametral tension; the halves then carried up "
+                  "to %.4g MPa",
                   1e-6 * r["split"]["peak_Pa"].get<double>());
     std::printf("\n");
   } else if (r.contains("tensile_strength_Pa")) {

@@ -391,24 +391,26 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
     sum.add(s.tests[k], jobs[k], out);
   const nlohmann::json props = sum.properties();
   const int parallel = run.parallel, threads = run.threads;
-  nlohmann::json summary{{"suite", s.name},
-                         {"suite_file", s.file},
-                         {"suite_hash", s.text_hash},
-                         {"material", s.material.value("name", "")},
-                         {"material_file", s.material_file},
-                         {"units", "SI (m, kg, s, N, Pa, J); stresses compression positive"},
-                         {"properties", props},
-                         {"methods",
-                          {{"crack_initiation_over_ucs",
-                            "crack volumetric strain (Martin & Chandler 1994), as laboratory cores "
-                            "are read; crack_initiation_count_over_ucs: the crack count onset"},
-                           {"bts_Pa", "the largest load up to the diametral split"}}},
-                         {"warnings", sum.warnings},
-                         {"tests", sum.tests},
-                         {"parallel_processes", parallel},
-                         {"threads_per_process", threads},
-                         {"rocklab_version", ROCKLAB_VERSION},
-                         {"wall_time_s", std::chrono::duration<double>(clock::now() - t0).count()}};
+  nlohmann::json summary{
+      {"suite", s.name},
+      {"suite_file", s.file},
+      {"suite_hash", s.text_hash},
+      {"material", s.material.value("name", "")},
+      {"material_file", s.material_file},
+      {"units", "SI (m, kg, s, N, Pa, J); stresses compression positive"},
+      {"properties", props},
+      {"methods",
+       {{"crack_initiation_over_ucs",
+         "crack volumetric strain (Martin & Chandler 1994), as laboratory cores "
+         "are read; crack_initiation_count_over_ucs: the crack count onset"},
+        {"bts_Pa",
+         "the largest load before the disk lost the tension across its loaded diameter"}}},
+      {"warnings", sum.warnings},
+      {"tests", sum.tests},
+      {"parallel_processes", parallel},
+      {"threads_per_process", threads},
+      {"rocklab_version", ROCKLAB_VERSION},
+      {"wall_time_s", std::chrono::duration<double>(clock::now() - t0).count()}};
   auto cell = [](const nlohmann::json& v) {
     return v.is_number() ? format_double(v.get<double>()) : std::string();
   };

@@ -2,6 +2,7 @@
 // suites, bad protocols, checkpoint/resume and SIGINT. Tiny specimens keep these fast.
 #include "helpers.hpp"
 
+#include "contact/contact_bond.hpp"
 #include "io/json_input.hpp"
 #include "io/specimen.hpp"
 #include "lab/frame/loading_frame.hpp"
@@ -297,9 +298,8 @@ TEST(Lab, BrazilianAndDirectTension) {
   ASSERT_TRUE(b.contains("split")) << b.dump(1);
   EXPECT_TRUE(b["split"]["found"].get<bool>()) << b["stop_reason"];
   EXPECT_NE(b["stop_reason"].get<std::string>().find("split"), std::string::npos);
-  // The tensile strength is the largest load up to the crack that completed the split: that
-  // crack (cracks.csv) makes six adjacent tenths of the loaded diameter cracked within 0.2 D of
-  // it, the cracks before it do not, and no history row before it carries more load.
+  // The split is the crack (cracks.csv) that makes six adjacent tenths of the loaded diameter
+  // cracked within 0.2 D of it; the cracks before it do not.
   const std::int64_t split = b["split"]["step"].get<std::int64_t>();
   const double d = b["specimen"]["diameter_m"].get<double>();
   std::array<bool, 10> bins{};
@@ -331,12 +331,22 @@ TEST(Lab, BrazilianAndDirectTension) {
   }
   EXPECT_GE(longest(), 6);
   EXPECT_LT(before, 6);
+  // The tensile strength is the largest load before the disk lost the tension it carries across
+  // its loaded diameter (the peak if it never did); an intact elastic disk carries about 2F/pi.
   const double bts = b["tensile_strength_Pa"].get<double>();
   EXPECT_LE(bts, b["split"]["peak_Pa"].get<double>());
-  EXPECT_LE(b["tensile_strength_step"].get<std::int64_t>(), split);
+  const double per_force = b["split"]["tension_per_force"].get<double>();
+  EXPECT_GT(per_force, 0.5 * 2 / M_PI);
+  EXPECT_LT(per_force, 1.5 * 2 / M_PI);
+  std::int64_t lost = b["split"]["tension_lost_step"].get<std::int64_t>();
+  if (lost >= 0)
+    EXPECT_LT(b["split"]["tension_per_force_at_loss"].get<double>(), 0.6 * per_force);
+  else
+    lost = std::numeric_limits<std::int64_t>::max();
+  EXPECT_LE(b["tensile_strength_step"].get<std::int64_t>(), lost);
   const auto hist = read_csv(bz_out / "history.csv");
   for (std::size_t i = 1; i < hist.size(); ++i) {
-    if (std::stoll(hist[i][1]) <= split) {
+    if (std::stoll(hist[i][1]) <= lost) {
       EXPECT_LE(std::stod(hist[i][6]), bts * (1 + 1e-12)) << "history row " << i;
     }
   }
@@ -513,6 +523,69 @@ TEST(Lab, BrazilianStrengthIsTheLoadBeforeTheSplitNotTheHalvesLoadedAfterIt) {
   EXPECT_LT(strongest_before(samples, peak, -1).load, 0); // no split, no strength
 }
 
+// The tension across the loaded diameter (closed form on a bonded pair) and the rule that reads
+// the Brazilian strength before the disk loses it.
+TEST(Lab, BrazilianStrengthIsReadBeforeTheDiskLosesItsDiametralTension) {
+  // Two grains bonded across the disk's centre line, pulled apart (then pushed together) along x:
+  // the bond's force crosses the planes at 0.1R, 0.6R, -0.4R and -0.9R (D = 10 R, centre 0.1 R),
+  // not the one at 1.1 R, so the plane average is 4/5 of the tension, and 0 in compression.
+  for (const double v : {0.01, -0.01}) {
+    Model m;
+    m.settings.dim = 3;
+    m.settings.gravity = Vec3::Zero();
+    m.settings.local_damping = 0;
+    m.settings.timestep = 1e-6;
+    const double R = 0.01;
+    const auto grp = m.group_index("rock");
+    m.balls.add(3, 1, Vec3(-R, 0, 0), R, 2600, grp);
+    m.balls.add(3, 2, Vec3(R, 0, 0), R, 2600, grp);
+    m.balls.fixity[0] = m.balls.fixity[1] = 0x3f;
+    m.balls.vel[1] = Vec3(v, 0, 0);
+    ContactBondProps p;
+    p.linear.kn = p.linear.ks = 1e8;
+    p.cb_tenf = p.cb_shearf = 1e9;
+    ModelRule rule;
+    rule.props = p;
+    m.rules.push_back(rule);
+    m.initialize();
+    m.cycle(100);
+    ASSERT_EQ(m.contacts().size(), 1u);
+    const double fx = m.contact_outputs()[0].force.x(); // on grain 2: < 0 pulls it back
+    ASSERT_GT(std::abs(fx), 1.0);
+    SpecimenGeometry g;
+    g.center = Vec3(0.1 * R, 0, 0);
+    g.width0 = Vec3(10 * R, 10 * R, 0);
+    EXPECT_NEAR(diametral_tension(m, g), v > 0 ? 0.8 * -fx : 0.0, 1e-9 * std::abs(fx));
+  }
+  // Readings of (step, load, tension per unit force): the elastic climb at 0.55, a platen grain
+  // giving way (load falls, the internal tension lags: 0.9), the climb again with a burst of
+  // cracking that dips the ratio for 20 steps, a split that drops it to 0.3 for good while the
+  // halves load on as columns to 30 MPa.
+  std::vector<TensionReading> r;
+  const double floor = 5e5;
+  const std::int64_t persist = 50;
+  auto loss = [&](double kept, double fl) { return tension_loss(r, kept, 0.3, fl, persist); };
+  r.push_back({10, 2e5, 1.5}); // the seating load: locked-in forces dominate, below the floor
+  for (int k = 1; k <= 10; ++k)
+    r.push_back({100 + 10 * k, 1e6 * k, 0.55});
+  r.push_back({210, 6e6, 0.9});  // collapse to 0.6 of the peak: not a reference reading
+  r.push_back({220, 2e6, 0.25}); // below failed (0.3) of the peak: the re-seating rule's
+  for (int k = 6; k <= 20; ++k)
+    r.push_back({300 + 10 * k, 1e6 * k, k == 15 || k == 16 ? 0.2 : 0.5}); // dip at 450-460
+  EXPECT_EQ(loss(0.6, floor).step, -1); // 0.5 >= 0.6 of 0.55, the dip too short
+  EXPECT_DOUBLE_EQ(loss(0.6, floor).reference, 0.55);
+  EXPECT_EQ(tension_loss(r, 0.6, 0.3, floor, 10).step, 450); // a dip of 10 steps is enough here
+  r.push_back({600, 19e6, 0.3});         // the split: the ratio falls to 0.55 of the reference
+  EXPECT_EQ(loss(0.6, floor).step, 600); // below to the end of the readings
+  for (int k = 21; k <= 30; ++k)
+    r.push_back({600 + 10 * k, 1e6 * k, 0.3});
+  EXPECT_EQ(loss(0.6, floor).step, 600);
+  EXPECT_DOUBLE_EQ(loss(0.6, floor).ratio, 0.3);
+  EXPECT_EQ(loss(0.5, floor).step, -1); // kept above half: no loss
+  // Without the floor the seating reading (1.5) would be the reference and the climb a loss.
+  EXPECT_EQ(loss(0.6, 0).step, 110);
+}
+
 TEST(Lab, EnvelopeFitRecoversMohrCoulombAndHoekBrown) {
   const double phi = 35.0 * M_PI / 180, c = 20e6;
   const double q = (1 + std::sin(phi)) / (1 - std::sin(phi));
@@ -664,6 +737,12 @@ TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
     EXPECT_NE(msg.find(k.message), std::string::npos) << msg;
     EXPECT_NE(msg.find(file), std::string::npos) << msg;
     EXPECT_FALSE(fs::exists(out)) << k.j.dump();
+  }
+  // The documented ends of stop.split_fraction are allowed: 0 turns the split check off.
+  for (const double f : {0.0, 1.0}) {
+    const nlohmann::json j = {
+        {"test", "brazilian"}, {"specimen", {{"file", spec}}}, {"stop", {{"split_fraction", f}}}};
+    EXPECT_EQ(protocol_from_json(j, "p.json", "").split_fraction, f);
   }
 }
 

@@ -208,8 +208,10 @@ void LoadingFrame::advance() {
   reload_peak_ = std::max(reload_peak_, current_.load);
   const std::int64_t loading = m_.step() - load_start_step_;
   const std::int64_t fine = std::max<std::int64_t>(1, p_.history_every / 10);
-  if (loading % fine == 0)
+  if (loading % fine == 0) {
     samples_.push_back(current_);
+    test_.sampled(*this, current_);
+  }
   if (!lateral_.empty())
     band_.add(current_.lateral_stress);
   track_peak();

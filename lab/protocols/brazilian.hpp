@@ -16,6 +16,32 @@ namespace rocklab {
 std::int64_t split_crack_step(const std::vector<Crack>& cracks, const SpecimenGeometry& g,
                               double fraction);
 
+/// The tension the disk carries across its loaded diameter: the tensile x-components of the
+/// grain-grain contact forces that cross a plane normal to x, averaged over five planes at the
+/// centre and 0.05 D and 0.1 D either side of it (a fracture wanders) [N]; 2D per unit thickness.
+/// An elastic disk under line loads carries 2F/pi across its diameter (Hondros; Jaeger & Cook).
+double diametral_tension(const Model& m, const SpecimenGeometry& g);
+
+/// One reading of the tension across the diameter per unit platen force [-] (elastic disk under
+/// line loads: 2/pi on one plane) with the load [Pa] at the same step.
+struct TensionReading {
+  std::int64_t step = 0;
+  double load = 0, ratio = 0;
+};
+
+/// When the disk lost its diametral tension: the first reading of a run of readings whose ratio
+/// stayed below `kept` times the reference for at least `persist` steps (or to the end), the
+/// reference being the largest ratio of the earlier readings that carried at least 0.9 of the
+/// peak so far (the climb; a falling load leaves the internal tension behind for a while).
+/// Readings below the load `floor` [Pa] or below `failed` of the peak so far (a collapse is the
+/// re-seating rule's, not a split) are skipped. step -1 if it never did.
+struct TensionLoss {
+  std::int64_t step = -1;
+  double reference = 0, ratio = 0; ///< the reference ratio and the ratio at the loss [-]
+};
+TensionLoss tension_loss(const std::vector<TensionReading>& r, double kept, double failed,
+                         double floor, std::int64_t persist);
+
 /// The reading with the largest load up to step `split` (the peak itself when it came first);
 /// load -1 when no reading precedes the split.
 LabSample strongest_before(const std::vector<LabSample>& samples, const PeakRecord& peak,

@@ -37,6 +37,8 @@ public:
   virtual double axial_strain(const LoadingFrame& f) const = 0;
   /// Axial stress and load of a reading whose force and lateral channels are read [Pa].
   virtual void stresses(const LoadingFrame& f, LabSample& s) const = 0;
+  /// Called with each fine reading of the loading (every history_every / 10 steps).
+  virtual void sampled(const LoadingFrame& /*f*/, const LabSample& /*s*/) {}
   /// Called at stop checks once the load fell below stop.post_peak_fraction of its peak: the stop
   /// reason, or "" to go on (default: stop).
   virtual std::string stop_after_drop(LoadingFrame& f);
