@@ -44,17 +44,6 @@ bool ShapeSpec::contains(const Vec3& x, double m) const {
   return false;
 }
 
-std::string text_hash(const std::string& text) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
-
 namespace {
 
 ShapeSpec read_shape(JsonObject o, int dim) {

@@ -4,6 +4,7 @@
 
 #include "contact/registry.hpp"
 #include "core/types.hpp"
+#include "io/json_input.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -119,8 +120,5 @@ struct GenesisOverrides {
 
 /// Apply the overrides to a card; a bad shape fails naming where it was given.
 void apply_overrides(MaterialCard& card, const GenesisOverrides& o);
-
-/// FNV-1a 64-bit hash of a text, as 16 hex digits (stable across platforms).
-std::string text_hash(const std::string& text);
 
 } // namespace rocklab

@@ -738,6 +738,23 @@ TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
     EXPECT_NE(msg.find(file), std::string::npos) << msg;
     EXPECT_FALSE(fs::exists(out)) << k.j.dump();
   }
+  // A specimen file with one byte changed after rocklab wrote it: exit 2 naming it, nothing
+  // written.
+  {
+    std::string bytes = test::read_file(spec);
+    bytes[bytes.size() - 7] ^= 0x10;
+    const fs::path bad = test::scratch_root() / "corrupt.rlspec";
+    std::ofstream(bad, std::ios::binary) << bytes;
+    const std::string file =
+        protocol("bad", {{"test", "ucs"}, {"specimen", {{"file", bad.string()}}}});
+    const fs::path out = scratch("bad_out");
+    std::string msg;
+    EXPECT_EQ(test::run_command(test::binary() + " test " + file + " -o " + out.string(), &msg), 2)
+        << msg;
+    EXPECT_NE(msg.find(bad.string() + ": the body does not match its checksum"), std::string::npos)
+        << msg;
+    EXPECT_FALSE(fs::exists(out));
+  }
   // The documented ends of stop.split_fraction are allowed: 0 turns the split check off.
   for (const double f : {0.0, 1.0}) {
     const nlohmann::json j = {

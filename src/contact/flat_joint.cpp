@@ -467,4 +467,14 @@ nlohmann::json FlatJoint::state_json(const Contact& f, ConstElements els, int di
   return j;
 }
 
+std::string FlatJoint::check_loaded(const Contact& c, const Pool& pool) {
+  if (std::size_t{c.elem} + c.n_elem > pool.all.size())
+    return "flat-joint elements outside the element pool";
+  if (c.geo == nullptr || c.n_elem != c.geo->A.size())
+    return "flat-joint element count does not match its discretisation";
+  if (c.mtype < 1 || c.mtype > 4)
+    return "flat-joint type " + std::to_string(c.mtype) + " (1 to 4 allowed)";
+  return {};
+}
+
 } // namespace rocklab

@@ -169,6 +169,9 @@ struct FlatJoint {
   template <class A> static void io(A& a, Pool& pool) {
     a.vec(pool.all, [&](FlatJointElement& e) { io(a, e); });
   }
+  /// A contact read from a file: its elements inside the pool, as many as its discretisation
+  /// has, its type known; else what is wrong.
+  static std::string check_loaded(const Contact& c, const Pool& pool);
 };
 
 } // namespace rocklab

@@ -128,6 +128,9 @@ public:
 
   /// Read or write the whole state (archive = specimen/checkpoint reader or writer).
   template <class Archive> void serialize(Archive& a);
+  /// After reading: every index in range and every value a run can use, else the corrupt part
+  /// (a specimen or checkpoint file's body is validated field by field, src/io/specimen.cpp).
+  std::string check_loaded() const;
 
 private:
   void ensure_thread_buffers();

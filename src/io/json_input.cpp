@@ -1,6 +1,7 @@
 #include "io/json_input.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -363,6 +364,17 @@ void JsonObject::finish() const {
     throw InputError(file_ + ": unknown key '" + key_path(it.key()) +
                      "' (allowed here: " + allowed + ")");
   }
+}
+
+std::string text_hash(std::string_view text) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (unsigned char c : text) {
+    h ^= c;
+    h *= 1099511628211ULL;
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
 }
 
 } // namespace rocklab

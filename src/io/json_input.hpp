@@ -13,6 +13,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace rocklab {
@@ -40,6 +41,10 @@ enum class Nulls { Reject, Allow };
 std::string not_an_input_file(const std::string& path);
 /// The bytes of an input file; a directory, a device or an unreadable file is an input error.
 std::string read_input_text(const std::string& path);
+
+/// FNV-1a 64-bit hash of bytes, as 16 hex digits (stable across platforms): input texts for the
+/// caches, specimen and checkpoint bodies for their checksum. Any single changed byte changes it.
+std::string text_hash(std::string_view text);
 nlohmann::json read_json_file(const std::string& path, Nulls nulls = Nulls::Reject);
 
 /// A JSON object being read: tracks the keys used so unknown keys can be reported.

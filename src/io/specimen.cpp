@@ -2,7 +2,9 @@
 
 #include "io/json_input.hpp"
 
+#include <array>
 #include <bit>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -57,9 +59,30 @@ struct ArchiveReader {
     for (int k = 0; k < 3; ++k)
       (*this)(v[k]);
   }
+  // Flags and enumerations are bytes with few valid values: a byte read into a bool that is not
+  // 0 or 1 is undefined behaviour, an unknown enumerator selects nothing.
+  std::uint8_t byte_at_most(std::uint8_t hi, const char* what) {
+    std::uint8_t b = 0;
+    (*this)(b);
+    if (b > hi)
+      throw InputError(file + ": corrupt specimen body (" + what + " holds " + std::to_string(b) +
+                       ", at most " + std::to_string(hi) + " allowed)");
+    return b;
+  }
+  void operator()(bool& v) { v = byte_at_most(1, "a flag") != 0; }
+  void operator()(BondState& v) { v = static_cast<BondState>(byte_at_most(3, "a bond state")); }
+  void operator()(ContactKind& v) {
+    v = static_cast<ContactKind>(byte_at_most(1, "a contact kind"));
+  }
+  void operator()(ModelKind& v) {
+    v = static_cast<ModelKind>(byte_at_most(kModelCount - 1, "a contact model"));
+  }
   void operator()(std::string& s) {
     std::uint64_t n = 0;
     (*this)(n);
+    if (n > bytes.size() - pos) // need(n) would wrap around for n near 2^64
+      throw InputError(file + ": truncated or corrupt specimen body (a string of " +
+                       std::to_string(n) + " bytes)");
     need(n);
     s.assign(bytes.data() + pos, n);
     pos += n;
@@ -173,18 +196,61 @@ template <class A> void Model::serialize(A& a) {
   if constexpr (A::reading) {
     if (outputs_.size() != contacts_.size())
       throw InputError("corrupt specimen body (contact arrays of different lengths)");
-    for (const Contact& c : contacts_)
-      if (c.end1 < 0 || static_cast<std::size_t>(c.end1) >= n ||
-          (c.kind == ContactKind::BallBall &&
-           (c.end2 < 0 || static_cast<std::size_t>(c.end2) >= n)))
-        throw InputError("corrupt specimen body (contact end out of range)");
-    for (std::size_t k = 0; k < clumps.size(); ++k)
-      for (std::int32_t p : clumps[k].pebbles)
-        if (p < 0 || static_cast<std::size_t>(p) >= n ||
-            balls.clump[static_cast<std::size_t>(p)] != static_cast<std::int32_t>(k))
-          throw InputError("corrupt specimen body (clump pebble out of range)");
+    if (const std::string bad = check_loaded(); !bad.empty())
+      throw InputError("corrupt specimen body (" + bad + ")");
     rebuild_adjacency(); // derived data, exactly as detection builds it
   }
+}
+
+std::string Model::check_loaded() const {
+  const std::size_t n = balls.size();
+  const auto in = [](std::int64_t i, std::size_t size) {
+    return i >= 0 && static_cast<std::size_t>(i) < size;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!balls.pos[i].allFinite() || !balls.vel[i].allFinite() || !balls.spin[i].allFinite())
+      return "ball " + std::to_string(i) + ": a position or velocity is not finite";
+    if (!(balls.radius[i] > 0 && std::isfinite(balls.radius[i])) || !(balls.mass[i] > 0))
+      return "ball " + std::to_string(i) + ": radius or mass not positive";
+    if (!in(balls.group[i], group_names.size()))
+      return "ball " + std::to_string(i) + ": group index out of range";
+    if (balls.clump[i] != -1 && !in(balls.clump[i], clumps.size()))
+      return "ball " + std::to_string(i) + ": clump index out of range";
+  }
+  for (std::size_t k = 0; k < clumps.size(); ++k)
+    for (std::int32_t p : clumps[k].pebbles)
+      if (!in(p, n) || balls.clump[static_cast<std::size_t>(p)] != static_cast<std::int32_t>(k))
+        return "clump " + std::to_string(k) + ": pebble out of range";
+  for (const Wall& w : walls)
+    for (const Facet& f : w.facets)
+      if (f.nv < 2 || f.nv > 3)
+        return "wall '" + w.name + "': a facet with " + std::to_string(f.nv) + " vertices";
+  std::array<std::size_t, kModelCount> slots{};
+  for_each_model([&]<class M>() {
+    slots[static_cast<std::size_t>(model_kind<M>)] = batches_.of<M>().contacts.size();
+  });
+  for (std::size_t k = 0; k < contacts_.size(); ++k) {
+    const Contact& c = contacts_[k];
+    const bool facet = c.kind == ContactKind::BallFacet;
+    if (!in(c.end1, n) || (!facet && !in(c.end2, n)) || (facet && !in(c.end2, walls.size())))
+      return "contact " + std::to_string(k) + ": end out of range";
+    if (facet && c.facet != -1 &&
+        !in(c.facet, walls[static_cast<std::size_t>(c.end2)].facets.size()))
+      return "contact " + std::to_string(k) + ": facet out of range";
+    if (!in(c.slot, slots[static_cast<std::size_t>(c.model)]))
+      return "contact " + std::to_string(k) + ": model slot out of range";
+    if (c.key != contact_key(c.kind, c.end1, c.end2))
+      return "contact " + std::to_string(k) + ": key does not match its ends";
+  }
+  std::string bad;
+  for_each_model([&]<class M>() {
+    if constexpr (HasPool<M>) {
+      const Batch<M>& b = batches_.of<M>();
+      for (std::size_t k = 0; k < b.contacts.size() && bad.empty(); ++k)
+        bad = M::check_loaded(b.contacts[k], b.pool);
+    }
+  });
+  return bad;
 }
 
 template void Model::serialize<ArchiveWriter>(ArchiveWriter&);
@@ -200,6 +266,8 @@ void save_model(const Model& m, const std::string& path, const nlohmann::json& m
                         {"balls", m.balls.size()},
                         {"contacts", m.contacts().size()},
                         {"body_bytes", w.bytes.size()},
+                        {"body_fnv1a64", text_hash(w.bytes)},
+                        {"meta_fnv1a64", text_hash(meta.dump())},
                         {"meta", meta}};
   const std::filesystem::path target(path);
   const std::filesystem::path tmp = target.string() + ".partial";
@@ -231,17 +299,44 @@ std::unique_ptr<Model> load_model(const std::string& path, nlohmann::json* meta)
   } catch (const nlohmann::json::exception&) {
     throw InputError(path + ": not a rocklab specimen file (no JSON header line)");
   }
-  if (!header.is_object() || header.value("format", "") != "rocklab-specimen")
+  if (!header.is_object() || !header.contains("format") || header["format"] != "rocklab-specimen")
     throw InputError(path + ": not a rocklab specimen file (format is not \"rocklab-specimen\")");
-  const int version = header.value("version", 0);
-  if (version != kSpecimenVersion)
+  const auto header_number = [&](const char* key) {
+    if (!header.contains(key) || !header[key].is_number_unsigned())
+      throw InputError(path + ": key '" + key +
+                       "': " + (header.contains(key) ? "value " + header[key].dump() : "missing") +
+                       " (a whole number >= 0 expected in the header line)");
+    return header[key].get<std::uint64_t>();
+  };
+  const std::uint64_t version = header_number("version");
+  if (version != kSpecimenVersion && version != 5)
     throw InputError(path + ": key 'version': value " + std::to_string(version) +
-                     " is not supported (this rocklab reads version " +
+                     " is not supported (this rocklab reads versions 5 and " +
                      std::to_string(kSpecimenVersion) + ")");
+  const std::uint64_t body_bytes = header_number("body_bytes");
   const std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (body.size() != header.value("body_bytes", static_cast<std::size_t>(0)))
+  if (body.size() != body_bytes)
     throw InputError(path + ": truncated specimen file (body has " + std::to_string(body.size()) +
-                     " bytes, header says " + header["body_bytes"].dump() + ")");
+                     " bytes, header says " + std::to_string(body_bytes) + ")");
+  // The checksum first: a changed byte anywhere in the body is named as such, before any field
+  // is read from it (version 5 files predate it).
+  if (version >= 6) {
+    if (!header.contains("body_fnv1a64") || !header["body_fnv1a64"].is_string())
+      throw InputError(path + ": key 'body_fnv1a64': missing (the body's checksum)");
+    if (header["body_fnv1a64"].get<std::string>() != text_hash(body))
+      throw InputError(path + ": the body does not match its checksum (key 'body_fnv1a64': " +
+                       header["body_fnv1a64"].dump() + ", the body hashes to \"" + text_hash(body) +
+                       "\"): the file was changed or damaged after rocklab wrote it");
+  }
+  if (header.contains("meta") && !header["meta"].is_object() && !header["meta"].is_null())
+    throw InputError(path + ": key 'meta': not an object");
+  // The metadata (a checkpoint's machine state) has its own checksum over its JSON text.
+  if (version >= 6) {
+    const std::string meta_hash = text_hash(header.value("meta", nlohmann::json()).dump());
+    if (header.value("meta_fnv1a64", nlohmann::json()) != meta_hash)
+      throw InputError(path + ": key 'meta' does not match its checksum (key 'meta_fnv1a64'): "
+                              "the file was changed or damaged after rocklab wrote it");
+  }
   ArchiveReader r{body, 0, path};
   auto m = std::make_unique<Model>();
   try {

@@ -14,13 +14,16 @@
 
 namespace rocklab {
 
-inline constexpr int kSpecimenVersion = 5;
+/// 6: the header carries the body's checksum (`body_fnv1a64`); version 5 files (no checksum) are
+/// still read, field by field validated like every file.
+inline constexpr int kSpecimenVersion = 6;
 
 /// Write atomically (temporary file, then rename). Throws std::runtime_error naming the file.
 void save_model(const Model& m, const std::string& path, const nlohmann::json& meta = {});
 
 /// Read a file written by save_model; `meta` receives the header's "meta" object.
-/// Throws InputError naming the file on a wrong format, version or truncated body.
+/// Throws InputError naming the file on a wrong format, version, checksum, truncated body or a
+/// field out of range (an index that names nothing, a flag that is not 0 or 1, ...).
 std::unique_ptr<Model> load_model(const std::string& path, nlohmann::json* meta = nullptr);
 
 } // namespace rocklab
