@@ -48,6 +48,27 @@ inline ModelRule linear_rule(bool ball_facet, LinearProps p) {
   return r;
 }
 
+/// Two balls of radius R (3D, 2600 kg/m^3) at a and b with every degree of freedom fixed, ball 2
+/// moving at v, one rule for every contact: no gravity or damping, dt 1e-6 s; initialized.
+inline std::unique_ptr<Model> driven_pair(const Vec3& a, const Vec3& b, double R, const Vec3& v,
+                                          const ModelProps& props) {
+  auto m = std::make_unique<Model>();
+  m->settings.dim = 3;
+  m->settings.gravity = Vec3::Zero();
+  m->settings.local_damping = 0;
+  m->settings.timestep = 1e-6;
+  const auto g = m->group_index("rock");
+  m->balls.add(3, 1, a, R, 2600, g);
+  m->balls.add(3, 2, b, R, 2600, g);
+  m->balls.fixity[0] = m->balls.fixity[1] = 0x3f; // every DOF fixed
+  m->balls.vel[1] = v;
+  ModelRule rule;
+  rule.props = props;
+  m->rules.push_back(rule);
+  m->initialize();
+  return m;
+}
+
 inline std::string source_dir() {
   return ROCKLAB_SOURCE_DIR;
 }

@@ -142,28 +142,15 @@ struct BondRun {
 };
 
 BondRun drive_bonded_pair(const Vec3& v, double tenf, double shearf, double kn, double steps) {
-  Model m;
-  m.settings.dim = 3;
-  m.settings.gravity = Vec3::Zero();
-  m.settings.local_damping = 0;
-  m.settings.timestep = 1e-6;
-  const double R = 0.01;
-  const auto g = m.group_index("rock");
-  m.balls.add(3, 1, Vec3::Zero(), R, 2600, g);
-  m.balls.add(3, 2, Vec3(0, 0, 2 * R), R, 2600, g);
-  for (std::size_t i = 0; i < 2; ++i)
-    m.balls.fixity[i] = 0x3f; // every DOF fixed
-  m.balls.vel[1] = v;
   ContactBondProps p;
   p.linear.kn = kn;
   p.linear.ks = kn;
   p.linear.fric = 0.5;
   p.cb_tenf = tenf;
   p.cb_shearf = shearf;
-  ModelRule rule;
-  rule.props = p;
-  m.rules.push_back(rule);
-  m.initialize();
+  const double R = 0.01;
+  const auto pair = test::driven_pair(Vec3::Zero(), Vec3(0, 0, 2 * R), R, v, p);
+  Model& m = *pair;
   BondRun r;
   for (int k = 0; k < steps; ++k) {
     m.cycle(1);

@@ -530,24 +530,12 @@ TEST(Lab, BrazilianStrengthIsReadBeforeTheDiskLosesItsDiametralTension) {
   // the bond's force crosses the planes at 0.1R, 0.6R, -0.4R and -0.9R (D = 10 R, centre 0.1 R),
   // not the one at 1.1 R, so the plane average is 4/5 of the tension, and 0 in compression.
   for (const double v : {0.01, -0.01}) {
-    Model m;
-    m.settings.dim = 3;
-    m.settings.gravity = Vec3::Zero();
-    m.settings.local_damping = 0;
-    m.settings.timestep = 1e-6;
     const double R = 0.01;
-    const auto grp = m.group_index("rock");
-    m.balls.add(3, 1, Vec3(-R, 0, 0), R, 2600, grp);
-    m.balls.add(3, 2, Vec3(R, 0, 0), R, 2600, grp);
-    m.balls.fixity[0] = m.balls.fixity[1] = 0x3f;
-    m.balls.vel[1] = Vec3(v, 0, 0);
     ContactBondProps p;
     p.linear.kn = p.linear.ks = 1e8;
     p.cb_tenf = p.cb_shearf = 1e9;
-    ModelRule rule;
-    rule.props = p;
-    m.rules.push_back(rule);
-    m.initialize();
+    const auto pair = test::driven_pair(Vec3(-R, 0, 0), Vec3(R, 0, 0), R, Vec3(v, 0, 0), p);
+    Model& m = *pair;
     m.cycle(100);
     ASSERT_EQ(m.contacts().size(), 1u);
     const double fx = m.contact_outputs()[0].force.x(); // on grain 2: < 0 pulls it back
