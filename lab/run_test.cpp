@@ -194,7 +194,8 @@ std::vector<PlotMarker> crack_markers(const LoadingFrame& f, const nlohmann::jso
   if (r.contains("split") && r["split"].contains("stress_Pa") &&
       r["split"]["stress_Pa"] != r["split"]["peak_Pa"])
     m.push_back({100 * r["peak_axial_strain"].get<double>(),
-                 1e-6 * r["tensile_strength_Pa"].get<double>(), "tensile strength (tension lost)"});
+                 1e-6 * r["tensile_strength_Pa"].get<double>(),
+                 "tensile strength (before the split)"});
   if (!r.contains("crack_stresses"))
     return m;
   const nlohmann::json& c = r["crack_stresses"];
