@@ -185,10 +185,10 @@ public:
         {"tension_kept_fraction", kTensionKept},
         {"peak_Pa", peak.load}, // the largest 2F/(pi D t) of the whole test
         {"peak_step", peak.step}};
-    const LabSample best =
-        split < 0 ? LabSample{0, 0, 0, 0, 0, 0, -1, 0}
-                  : strongest_before(f.samples(), peak,
-                                     lost >= 0 ? lost : std::numeric_limits<std::int64_t>::max());
+    // No split: no strength (strongest_before gives none); else up to the loss, or all of it.
+    const std::int64_t until =
+        split < 0 ? -1 : (lost >= 0 ? lost : std::numeric_limits<std::int64_t>::max());
+    const LabSample best = strongest_before(f.samples(), peak, until);
     if (best.load <= 0) { // no split, or one before loading began (seating)
       r["tensile_strength_Pa"] = nullptr;
       r["peak_force_N"] = peak.force;

@@ -33,19 +33,19 @@ struct Range {
   static Range half_open(double a, double b) { return {a, b, false, true}; }
 };
 
-/// Parse a JSON file; syntax errors name the file, line and column. A key given twice in one
-/// object, nesting deeper than 256 levels and (in input files, not in rocklab's own outputs read
-/// back) a null value are input errors naming the key path.
-enum class Nulls { Reject, Allow };
 /// Why `path` cannot be an input file (a directory, a device or a socket), or "".
 std::string not_an_input_file(const std::string& path);
 /// The bytes of an input file; a directory, a device or an unreadable file is an input error.
 std::string read_input_text(const std::string& path);
+/// Parse a JSON file; syntax errors name the file, line and column. A key given twice in one
+/// object, nesting deeper than 256 levels and (in input files, not in rocklab's own outputs read
+/// back) a null value are input errors naming the key path.
+enum class Nulls { Reject, Allow };
+nlohmann::json read_json_file(const std::string& path, Nulls nulls = Nulls::Reject);
 
 /// FNV-1a 64-bit hash of bytes, as 16 hex digits (stable across platforms): input texts for the
 /// caches, specimen and checkpoint bodies for their checksum. Any single changed byte changes it.
 std::string text_hash(std::string_view text);
-nlohmann::json read_json_file(const std::string& path, Nulls nulls = Nulls::Reject);
 
 /// A JSON object being read: tracks the keys used so unknown keys can be reported.
 class JsonObject {

@@ -46,7 +46,7 @@ struct ArchiveReader {
   std::string file;
   static constexpr bool reading = true;
   void need(std::size_t n) {
-    if (pos + n > bytes.size())
+    if (n > bytes.size() - pos) // pos <= size: no wrap-around for a length near 2^64
       throw InputError(file + ": truncated or corrupt specimen body");
   }
   template <class T>
@@ -80,9 +80,6 @@ struct ArchiveReader {
   void operator()(std::string& s) {
     std::uint64_t n = 0;
     (*this)(n);
-    if (n > bytes.size() - pos) // need(n) would wrap around for n near 2^64
-      throw InputError(file + ": truncated or corrupt specimen body (a string of " +
-                       std::to_string(n) + " bytes)");
     need(n);
     s.assign(bytes.data() + pos, n);
     pos += n;
@@ -318,20 +315,19 @@ std::unique_ptr<Model> load_model(const std::string& path, nlohmann::json* meta)
   if (body.size() != body_bytes)
     throw InputError(path + ": truncated specimen file (body has " + std::to_string(body.size()) +
                      " bytes, header says " + std::to_string(body_bytes) + ")");
-  // The checksum first: a changed byte anywhere in the body is named as such, before any field
-  // is read from it (version 5 files predate it).
-  if (version >= 6) {
-    if (!header.contains("body_fnv1a64") || !header["body_fnv1a64"].is_string())
-      throw InputError(path + ": key 'body_fnv1a64': missing (the body's checksum)");
-    if (header["body_fnv1a64"].get<std::string>() != text_hash(body))
-      throw InputError(path + ": the body does not match its checksum (key 'body_fnv1a64': " +
-                       header["body_fnv1a64"].dump() + ", the body hashes to \"" + text_hash(body) +
-                       "\"): the file was changed or damaged after rocklab wrote it");
-  }
   if (header.contains("meta") && !header["meta"].is_object() && !header["meta"].is_null())
     throw InputError(path + ": key 'meta': not an object");
-  // The metadata (a checkpoint's machine state) has its own checksum over its JSON text.
+  // The checksums first (version 5 files predate them): a changed byte anywhere in the body, or
+  // in the metadata (a checkpoint's machine state, hashed as its JSON text), is named as such
+  // before any field is read.
   if (version >= 6) {
+    const std::string body_hash = text_hash(body);
+    if (!header.contains("body_fnv1a64") || !header["body_fnv1a64"].is_string())
+      throw InputError(path + ": key 'body_fnv1a64': missing (the body's checksum)");
+    if (header["body_fnv1a64"].get<std::string>() != body_hash)
+      throw InputError(path + ": the body does not match its checksum (key 'body_fnv1a64': " +
+                       header["body_fnv1a64"].dump() + ", the body hashes to \"" + body_hash +
+                       "\"): the file was changed or damaged after rocklab wrote it");
     const std::string meta_hash = text_hash(header.value("meta", nlohmann::json()).dump());
     if (header.value("meta_fnv1a64", nlohmann::json()) != meta_hash)
       throw InputError(path + ": key 'meta' does not match its checksum (key 'meta_fnv1a64'): "
