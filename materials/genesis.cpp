@@ -6,7 +6,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <numbers>
+#include <sstream>
 
 namespace rocklab {
 
@@ -98,7 +100,14 @@ GenesisResult run_genesis(const MaterialCard& card,
   m.settings.local_damping = 0.7;
   m.settings.gravity = Vec3::Zero();
   m.settings.slip_events = false; // nobody reads them during genesis
+  const genesis::GenesisEstimate est = genesis::estimate_genesis(card);
   genesis::Run run(card, m, rep, progress, interrupt);
+  if (est.grains > 0) {
+    std::ostringstream msg;
+    msg << std::setprecision(3) << "estimate: about " << est.grains << " grains, "
+        << est.bytes / 1e6 << " MB, " << est.seconds << " s on one core";
+    run.say(msg.str());
+  }
   if (card.packing_import.empty()) {
     genesis::place_grains(run);
     const genesis::PackingKey key = genesis::packing_key(run);

@@ -65,6 +65,9 @@ TEST(Genesis, PorosityStressAndReleaseForEveryShape) {
     // After release the mean residual stress is below the documented tolerance.
     EXPECT_LE(std::abs(r.residual_mean_stress), c.residual_tolerance * c.pressure) << name;
     EXPECT_GT(r.grains, 150) << name;
+    // The estimate printed before genesis starts counts the grains within 10 %.
+    const double est = genesis::estimate_genesis(c).grains;
+    EXPECT_NEAR(est, static_cast<double>(r.grains + r.escaped), 0.1 * est) << name;
     EXPECT_GT(r.coordination, c.dim == 2 ? 2.5 : 3.5) << name;
     EXPECT_TRUE(g.model->walls.empty()) << name;
     if (c.bonding == MaterialCard::Bonding::FlatJoint) {
@@ -414,6 +417,47 @@ TEST(Genesis, BadCardsFailClearlyAndWriteNothing) {
     EXPECT_FALSE(fs::exists(out.string() + ".report.json"));
     EXPECT_FALSE(fs::exists(out.string() + ".partial"));
   }
+}
+
+// Issue 16 item 5: cards that cannot finish (a specimen of 1e-320 m cycled two million times
+// before failing; emod 1e30 or gap_ratio 2^63 kept genesis busy past a minute; a 1 km specimen of
+// 1 mm grains allocated until the system killed it) are refused before anything is made, naming
+// the key, the value and what is allowed.
+TEST(Genesis, CardsThatCannotFinishAreRefusedBeforeTheyStart) {
+  struct Case {
+    const char* from;
+    const char* to;
+    const char* message;
+  };
+  for (const Case& k :
+       {Case{"\"height\": 0.06", "\"height\": 1e-320", "key 'specimen': its smallest dimension"},
+        Case{"\"width\": 0.03", "\"width\": 0.005", "fewer than two of the largest grains"},
+        Case{"\"width\": 0.03", "\"width\": 1000", "grains of radius 0.001-0.0015 m"},
+        Case{"[0.001, 0.0015]", "[1e-9, 2e-9]", "key 'specimen': the specimen holds about"},
+        Case{"\"emod\": 1e9", "\"emod\": 1e30", "is a strain of 1e-25"},
+        Case{"\"pressure\": 1e5", "\"pressure\": 1e8", "is a strain of 0.1"},
+        Case{"\"gap_ratio\": 0.05", "\"gap_ratio\": 9.2233720368547758e18",
+             "key 'installation.gap_ratio'"},
+        Case{"\"gap_ratio\": 0.05", "\"gap\": 0.01", "key 'installation.gap'"}}) {
+    const MaterialCard c = load_material_card(edited_card("genesis_2d_rect.json", k.from, k.to));
+    try {
+      genesis::estimate_genesis(c);
+      ADD_FAILURE() << "accepted: " << k.to;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(k.message), std::string::npos) << e.what();
+    }
+  }
+  // At the edge of what is allowed: a specimen four largest radii wide passes the estimate.
+  const MaterialCard edge = load_material_card(
+      edited_card("genesis_2d_rect.json", "\"width\": 0.03", "\"width\": 0.006"));
+  EXPECT_GT(genesis::estimate_genesis(edge).grains, 10);
+  // Through the command line: exit 2 naming the card, nothing written.
+  const std::string bad = edited_card("genesis_2d_rect.json", "\"emod\": 1e9", "\"emod\": 1e30");
+  const fs::path out = scratch("unbounded.rlspec");
+  std::string msg;
+  EXPECT_EQ(test::run_command(test::binary() + " genesis " + bad + " -o " + out.string(), &msg), 2);
+  EXPECT_NE(msg.find(bad + ": key 'installation.pressure'"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(Genesis, ClumpedContactBondedSpecimen) {

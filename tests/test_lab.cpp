@@ -697,6 +697,9 @@ TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
       {{{"test", "shear_box"}, {"specimen", {{"file", spec}}}}, "key 'test'"},
       {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"strain_rate", -1}}}},
        "key 'loading.strain_rate'"},
+      // Too slow to strain the specimen measurably within stop.max_steps: refused, not cycled.
+      {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"strain_rate", 1e-9}}}},
+       "key 'loading.strain_rate': at 1e-09 1/s the 5000000 steps of 'stop.max_steps'"},
       {{{"test", "ucs"}}, "key 'specimen'"},
       {{{"test", "ucs"}, {"specimen", {{"file", "/nonexistent.rlspec"}}}}, "does not exist"},
       {{{"test", "triaxial"}, {"specimen", {{"file", spec}}}}, "key 'loading.confinement'"},

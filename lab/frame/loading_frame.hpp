@@ -169,6 +169,7 @@ public:
 private:
   // setup.cpp
   void measure_specimen(const std::string& shape, bool diametral);
+  void check_reachable_strain() const;
   LinearProps platen_contact(bool friction) const;
   std::int64_t add_wall(Wall w, const LinearProps& props);
   void add_platens(const LinearProps& props);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 
 namespace rocklab {
 
@@ -53,6 +54,7 @@ void LoadingFrame::setup() {
   v_final_ =
       p_.platen_velocity > 0 ? p_.platen_velocity : 0.5 * p_.strain_rate * geo_.loaded_length();
   m_.initialize();
+  check_reachable_strain();
   mark_energy_start();
   phase_ = setup.first_phase;
   phase_start_step_ = m_.step();
@@ -60,6 +62,24 @@ void LoadingFrame::setup() {
     begin_loading();
   measure(current_);
   record_history();
+}
+
+// A loading that cannot strain the specimen measurably within `stop.max_steps` would cycle to the
+// limit and report nothing (a rock fails at axial strains of 1e-3 to 1e-2): refused up front.
+void LoadingFrame::check_reachable_strain() const {
+  const double reach =
+      2 * v_final_ * m_.timestep() * static_cast<double>(p_.max_steps) / geo_.loaded_length();
+  if (reach >= 1e-4)
+    return;
+  std::ostringstream msg;
+  msg << p_.file << ": key '"
+      << (p_.platen_velocity > 0 ? "loading.platen_velocity" : "loading.strain_rate") << "': at "
+      << (p_.platen_velocity > 0 ? p_.platen_velocity : p_.strain_rate)
+      << (p_.platen_velocity > 0 ? " m/s" : " 1/s") << " the " << p_.max_steps
+      << " steps of 'stop.max_steps' (time step " << m_.timestep()
+      << " s) reach an axial strain of " << reach
+      << "; allowed: a rate and step limit that reach at least 1e-4";
+  throw InputError(msg.str());
 }
 
 void LoadingFrame::measure_specimen(const std::string& shape, bool diametral) {

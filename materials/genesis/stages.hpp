@@ -121,6 +121,18 @@ struct Run {
 std::vector<std::size_t> morton_order(const std::vector<Vec3>& x, int dim, double cell,
                                       const Vec3& lo);
 
+/// What a card's genesis will take (estimate.cpp); 0 for an imported packing.
+struct GenesisEstimate {
+  double grains = 0;  ///< expected grain count
+  double bytes = 0;   ///< expected peak memory
+  double seconds = 0; ///< expected wall time on one core at a preset's cycle count
+};
+/// The estimate, after refusing (InputError naming the key) a card that cannot finish: a specimen
+/// narrower than two of its largest grains, more grains than memory holds, an installation gap
+/// wider than a mean radius, an installation strain (pressure / grain modulus) outside
+/// [1e-10, 0.05].
+GenesisEstimate estimate_genesis(const MaterialCard& c);
+
 // The stages, in order (the file that holds each).
 void place_grains(Run& g); ///< cloud.cpp: radii, a cloud in the enlarged vessel, Morton order
 /// import.cpp: instead of the three above, grains read from the card's `packing.import`
