@@ -291,3 +291,36 @@ TEST(Cli, BondedModelsAreDeterministicAcrossThreads) {
     EXPECT_EQ(read_file(a / "results.json"), read_file(b / "results.json")) << name;
   }
 }
+
+// Issue 16 item 7: the unbalanced-force stop rule ignored moments, so a problem loaded by a moment
+// alone stopped at step 0. Now a ball's unbalanced moment counts (over its radius) and nothing is
+// checked before the first cycle: a bonded ball twisted by an applied moment turns until the
+// bond's moment balances it.
+TEST(Cli, TheUnbalancedForceStopCountsMoments) {
+  const std::string text = R"({
+    "dimension": 2, "local_damping": 0.7,
+    "balls": [{"id": 1, "position": [0, 0], "radius": 0.01, "density": 2650, "fix": "all"},
+              {"id": 2, "position": [0.02, 0], "radius": 0.01, "density": 2650,
+               "fix": ["x", "y"], "moment": 0.5}],
+    "contact_models": [{"between": "ball-ball", "model": "linearpbond",
+                        "properties": {"kn": 1e7, "pb_kn": 1e12, "pb_ks": 1e12,
+                                       "pb_ten": 1e20, "pb_coh": 1e20}}],
+    "run": {"unbalanced_force_ratio": 1e-4, "max_cycles": 200000}
+  })";
+  const fs::path scene = write_scene("moment", text);
+  const fs::path out = scratch("moment");
+  std::string msg;
+  ASSERT_EQ(run_command(binary() + " run " + scene.string() + " -o " + out.string() + " -q", &msg),
+            0)
+      << msg;
+  const auto r = nlohmann::json::parse(read_file(out / "results.json"));
+  EXPECT_GT(r["step"].get<long>(), 0);
+  EXPECT_LT(r["step"].get<long>(), 200000); // stopped by the ratio, not the cycle limit
+  // At rest the bond's moment and its shear force's moment about ball 2's centre (lever -R along
+  // x) balance the applied 0.5 N m (to the ratio 1e-4 of the load).
+  ASSERT_EQ(r["contacts"].size(), 1u);
+  const auto& c = r["contacts"][0];
+  const double about_centre = c["moment"].get<double>() - 0.01 * c["force"][1].get<double>();
+  EXPECT_NEAR(about_centre, -0.5, 5e-3) << c.dump();
+  EXPECT_GT(std::abs(c["moment"].get<double>()), 0.05) << c.dump(); // the bond carries its part
+}

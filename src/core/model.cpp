@@ -99,7 +99,7 @@ double Model::estimate_timestep() const {
   return dt;
 }
 
-double Model::mean_unbalanced_force_ratio() const {
+double Model::mean_unbalanced_force_ratio(bool with_moments) const {
   const int ntran = settings.dim == 2 ? 2 : 3;
   const auto ub = block_sum<1>(balls.size(), [&](std::size_t i, std::array<double, 1>& acc) {
     if (balls.clump[i] >= 0)
@@ -109,10 +109,23 @@ double Model::mean_unbalanced_force_ratio() const {
     for (int d = 0; d < ntran; ++d)
       if (!(balls.fixity[i] & dof_bit(d)))
         s += F[d] * F[d];
+    if (with_moments) { // the free rotations' unbalanced moment as a force at the radius
+      const Vec3 M = (balls.moment[i] + balls.applied_moment[i]) / balls.radius[i];
+      for (int d = settings.dim == 2 ? kRz : kRx; d <= kRz; ++d)
+        if (!(balls.fixity[i] & dof_bit(d)))
+          s += M[d - kRx] * M[d - kRx];
+    }
     acc[0] += std::sqrt(s);
   });
   const auto cf = block_sum<2>(contacts_.size(), [&](std::size_t ci, std::array<double, 2>& acc) {
-    const double f = outputs_[ci].force.norm();
+    double f = outputs_[ci].force.norm();
+    if (with_moments && outputs_[ci].moment.squaredNorm() > 0) {
+      const Contact& c = contacts_[ci];
+      double r = balls.radius[static_cast<std::size_t>(c.end1)];
+      if (c.kind == ContactKind::BallBall)
+        r = 0.5 * (r + balls.radius[static_cast<std::size_t>(c.end2)]);
+      f = std::hypot(f, outputs_[ci].moment.norm() / r);
+    }
     if (f > 0) {
       acc[0] += f;
       acc[1] += 1;

@@ -95,8 +95,11 @@ public:
 
   /// Current energies (stored partitions summed over contacts, accumulated ones from the ledger).
   EnergyLedger energy() const;
-  /// Mean unbalanced force over balls divided by the mean contact force magnitude.
-  double mean_unbalanced_force_ratio() const;
+  /// Mean unbalanced force over balls divided by the mean contact force magnitude. With moments
+  /// (the scenes' stop rule): a ball's unbalanced moment over its radius counts as a force on its
+  /// free rotations, and a contact's moment over its balls' mean radius adds to its load (as
+  /// sqrt(F^2 + (M/R)^2)); clumps count their resultant force only.
+  double mean_unbalanced_force_ratio(bool with_moments = false) const;
   /// Append the events buffered since the last drain (in a fixed order) to out and clear them.
   void drain_events(std::vector<Event>& out);
   /// Drop the buffered events (for callers that do not read them).

@@ -221,7 +221,7 @@ double history_value(const Model& m, const HistoryColumn& c, const EnergyLedger&
   case HistoryColumn::Kind::ActiveContacts:
     return static_cast<double>(m.active_contact_count());
   case HistoryColumn::Kind::Ratio:
-    return m.mean_unbalanced_force_ratio();
+    return m.mean_unbalanced_force_ratio(true);
   case HistoryColumn::Kind::Events:
     if (c.quantity == "contact_created")
       return static_cast<double>(counts.created);

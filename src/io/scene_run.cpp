@@ -51,9 +51,10 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
         return true;
       if (run.time > 0)
         return m.time() - time0 >= run.time;
-      if (steps % run.check_every != 0)
+      // Not before the first cycle: the forces and moments are computed there.
+      if (steps == 0 || steps % run.check_every != 0)
         return false;
-      return m.mean_unbalanced_force_ratio() < run.ratio;
+      return m.mean_unbalanced_force_ratio(true) < run.ratio;
     };
     while (!done()) {
       if (opts.interrupt && opts.interrupt->load())
@@ -80,7 +81,7 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
           else
             std::fprintf(stderr, "\r[rocklab] step %lld  t = %.4g s  ratio %.3g   ",
                          static_cast<long long>(m.step()), m.time(),
-                         m.mean_unbalanced_force_ratio());
+                         m.mean_unbalanced_force_ratio(true));
           std::fflush(stderr);
         }
       }
