@@ -137,17 +137,26 @@ void FrameRun::write_checkpoint() {
                             {"vtk_times", vtk->times()},
                             {"vtk_tagged", vtk->tagged()},
                             {"files", sum.files}}}};
-  // The files written so far are kept beside the checkpoint (a copy of the staging folder).
+  // The files written so far are kept beside the checkpoint (a copy of the staging folder). A
+  // checkpoint that cannot be written (disk full) leaves the last complete one as it was.
   const fs::path files = checkpoint + ".files";
   const fs::path tmp = checkpoint + ".files.partial";
+  const fs::path pending = checkpoint + ".pending";
   std::error_code ec;
-  fs::remove_all(tmp, ec);
-  fs::create_directories(tmp);
-  fs::copy(out.staged(""), tmp, fs::copy_options::recursive);
-  save_model(*model, checkpoint + ".pending", cmeta);
+  try {
+    fs::remove_all(tmp, ec);
+    fs::create_directories(tmp);
+    fs::copy(out.staged(""), tmp, fs::copy_options::recursive);
+    save_model(*model, pending.string(), cmeta);
+  } catch (const std::exception& e) {
+    fs::remove_all(tmp, ec);
+    fs::remove(pending, ec);
+    throw OutputError(checkpoint + ": cannot write the checkpoint (" + e.what() +
+                      "); the last complete checkpoint, if any, is kept");
+  }
   fs::remove_all(files, ec);
   fs::rename(tmp, files);
-  fs::rename(checkpoint + ".pending", checkpoint);
+  fs::rename(pending, checkpoint);
 }
 
 bool FrameRun::loop() {

@@ -1,5 +1,7 @@
 #include "viz/vtk_output.hpp"
 
+#include "io/output_dir.hpp"
+
 #include <algorithm>
 
 #include <vtkCellArray.h>
@@ -50,13 +52,14 @@ template <class T, class Arr> vtkNew<Arr> scalar_array(const char* name, const s
 }
 
 void write_poly(vtkPolyData* pd, const std::filesystem::path& p) {
+  vtkObject::GlobalWarningDisplayOff(); // a failed write is our OutputError, not VTK's log
   vtkNew<vtkXMLPolyDataWriter> w;
   w->SetFileName(p.string().c_str());
   w->SetInputData(pd);
   w->SetDataModeToAppended();
   w->EncodeAppendedDataOff();
   if (w->Write() != 1)
-    throw std::runtime_error(p.string() + ": VTK could not write the file");
+    throw OutputError(p.string() + ": VTK could not write the file (disk full?)");
 }
 
 // Two unit vectors spanning the plane normal to n.
@@ -150,13 +153,14 @@ void write_grains(const Snapshot& s, const std::filesystem::path& path) {
   pd->AddArray(vector_array("displacement", s.disp));
   pd->AddArray(scalar_array<std::int32_t, vtkIntArray>("group", s.group));
   pd->AddArray(scalar_array<std::int64_t, vtkLongLongArray>("id", s.id));
+  vtkObject::GlobalWarningDisplayOff();
   vtkNew<vtkXMLUnstructuredGridWriter> w;
   w->SetFileName(path.string().c_str());
   w->SetInputData(ug);
   w->SetDataModeToAppended();
   w->EncodeAppendedDataOff();
   if (w->Write() != 1)
-    throw std::runtime_error(path.string() + ": VTK could not write the file");
+    throw OutputError(path.string() + ": VTK could not write the file (disk full?)");
 }
 
 // Bonds: a line between the grain centres.
@@ -304,7 +308,7 @@ std::vector<std::string> VtkSeries::write_collections() const {
     std::ofstream f(dir_ / name, std::ios::binary);
     f << text;
     if (!f)
-      throw std::runtime_error((dir_ / name).string() + ": cannot write");
+      throw OutputError((dir_ / name).string() + ": cannot write");
     out.push_back(name);
   }
   return out;

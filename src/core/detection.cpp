@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cassert>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <omp.h>
@@ -89,12 +90,21 @@ detail::CellGrid Model::bin_balls() {
   }
   g.lo = lo;
   g.cell = std::max(2.0 * rmax + margin_, 1e-300);
+  // Counted in double: a ball far from the others (1e30 m) must widen the cells, not overflow the
+  // integer cell counts.
+  const double max_cells = static_cast<double>(std::max<std::size_t>(8 * n, 64));
+  if (n > 0 && !std::isfinite((hi - lo).maxCoeff()))
+    throw PhysicsError("the balls span more than a double can hold (over 1.8e308 m)");
   for (;;) {
+    double count = 1;
     for (int d = 0; d < g.dim; ++d)
-      g.nc[d] = static_cast<std::int64_t>((hi[d] - lo[d]) / g.cell) + 1;
-    if (g.nc[0] * g.nc[1] * g.nc[2] <= static_cast<std::int64_t>(std::max<std::size_t>(8 * n, 64)))
+      count *= std::floor((hi[d] - lo[d]) / g.cell) + 1;
+    if (count <= max_cells) {
+      for (int d = 0; d < g.dim; ++d)
+        g.nc[d] = static_cast<std::int64_t>((hi[d] - lo[d]) / g.cell) + 1;
       break;
-    g.cell *= 1.25;
+    }
+    g.cell *= 1.25; // (a few hundred rounds at most, even for 1e300 m)
   }
   // Counting sort of the balls by cell.
   const std::size_t ncells = g.cells();

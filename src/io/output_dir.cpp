@@ -1,5 +1,7 @@
 #include "io/output_dir.hpp"
 
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
@@ -17,14 +19,14 @@ OutputDir::OutputDir(const std::string& path) : dir_(path) {
   } else {
     fs::create_directories(dir_, ec);
     if (ec)
-      throw std::runtime_error(path + ": cannot create output directory: " + ec.message());
+      throw OutputError(path + ": cannot create output directory: " + ec.message());
     created_dir_ = true;
   }
   staging_ = dir_ / (".partial-" + std::to_string(::getpid()));
   fs::remove_all(staging_, ec);
   fs::create_directories(staging_, ec);
   if (ec)
-    throw std::runtime_error(staging_.string() + ": cannot create staging folder: " + ec.message());
+    throw OutputError(staging_.string() + ": cannot create staging folder: " + ec.message());
 }
 
 OutputDir::~OutputDir() {
@@ -48,11 +50,11 @@ void OutputDir::commit() {
 void write_file(const fs::path& p, const std::function<void(std::ostream&)>& write) {
   std::ofstream out(p, std::ios::binary);
   if (!out)
-    throw std::runtime_error(p.string() + ": cannot open for writing");
+    throw OutputError(p.string() + ": cannot open for writing: " + std::strerror(errno));
   write(out);
   out.close();
   if (!out)
-    throw std::runtime_error(p.string() + ": write failed (disk full?)");
+    throw OutputError(p.string() + ": write failed: " + std::strerror(errno));
 }
 
 void write_text_file(const fs::path& p, const std::string& text) {

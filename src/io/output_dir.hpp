@@ -5,9 +5,16 @@
 #include <filesystem>
 #include <functional>
 #include <iosfwd>
+#include <stdexcept>
 #include <string>
 
 namespace rocklab {
+
+/// An output that cannot be written (disk full, file-size limit, no permission): exit status 4,
+/// with what was staged removed (docs/errors.md).
+struct OutputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 class OutputDir {
 public:
@@ -28,7 +35,7 @@ private:
   bool committed_ = false;
 };
 
-/// Write a file by handing its stream to `write`; throws std::runtime_error naming the file when
+/// Write a file by handing its stream to `write`; throws OutputError naming the file when
 /// it cannot be opened or the write fails (disk full).
 void write_file(const std::filesystem::path& p, const std::function<void(std::ostream&)>& write);
 /// Write text to a file (write_file).

@@ -1,9 +1,11 @@
 #include "io/specimen.hpp"
 
 #include "io/json_input.hpp"
+#include "io/output_dir.hpp"
 
 #include <array>
 #include <bit>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -271,14 +273,15 @@ void save_model(const Model& m, const std::string& path, const nlohmann::json& m
   {
     std::ofstream out(tmp, std::ios::binary);
     if (!out)
-      throw std::runtime_error(path + ": cannot open for writing");
+      throw OutputError(path + ": cannot open for writing: " + std::strerror(errno));
     out << header.dump() << '\n';
     out.write(w.bytes.data(), static_cast<std::streamsize>(w.bytes.size()));
     out.close();
     if (!out) {
+      const int err = errno;
       std::error_code ec;
       std::filesystem::remove(tmp, ec);
-      throw std::runtime_error(path + ": write failed (disk full?)");
+      throw OutputError(path + ": write failed: " + std::strerror(err));
     }
   }
   std::filesystem::rename(tmp, target);
