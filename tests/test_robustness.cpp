@@ -2,6 +2,7 @@
 // part-way (full disk, file-size limit) and mutated input files. Each outcome must be one of the
 // documented exit statuses (docs/errors.md) with nothing half-written left behind.
 #include "helpers.hpp"
+#include "io/json_input.hpp"
 #include "mutate.hpp"
 
 #include <fcntl.h>
@@ -258,4 +259,65 @@ TEST(Robustness, MutatedInputFilesFailCleanlyOrRun) {
   // by a range check rather than by the JSON reader.
   EXPECT_GT(tally["exit 0"] + tally["stopped by SIGTERM"], count / 20);
   EXPECT_GT(tally["exit 2"], count / 4);
+}
+
+// Issue 16 item 1: a checkpoint's machine state was trusted — `peak: []` or `lateral: [1e9]`
+// crashed the restore, `top: 99` read out of bounds, `phase: 9` looped. Edited and re-hashed (so
+// the checksum passes), each is an input error naming the checkpoint; nothing is written.
+TEST(Robustness, ACheckpointWithAnImpossibleMachineStateIsAnInputError) {
+  const fs::path dir = scratch("cpstate");
+  fs::create_directories(dir);
+  const std::string card = test::source_dir() + "/tests/data/lab_2d_fj.json";
+  std::string msg;
+  ASSERT_EQ(test::run_command(test::binary() + " genesis " + card + " -o " +
+                                  (dir / "s.rlspec").string() + " -q --threads 1",
+                              &msg),
+            0)
+      << msg;
+  const std::string protocol = (dir / "ucs.json").string();
+  std::ofstream(protocol) << R"({"test": "ucs", "specimen": {"file": ")" +
+                                 (dir / "s.rlspec").string() + R"("}})";
+  // A checkpoint of a run interrupted while loading.
+  const fs::path out = dir / "out";
+  const std::string cp = out.string() + ".checkpoint";
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    execl(test::binary().c_str(), "rocklab", "test", protocol.c_str(), "-o", out.c_str(), "-q",
+          "--threads", "1", "--checkpoint-every", "300", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  for (int i = 0; i < 2000 && !fs::exists(cp); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ::kill(pid, SIGINT);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(fs::exists(cp));
+  const std::string bytes = test::read_file(cp);
+  const std::size_t eol = bytes.find('\n');
+  const nlohmann::json header = nlohmann::json::parse(bytes.substr(0, eol));
+  const std::string body = bytes.substr(eol + 1);
+  struct Case {
+    const char* key;
+    nlohmann::json value;
+  };
+  for (const Case& k :
+       {Case{"peak", nlohmann::json::array()}, Case{"lateral", {1e9}}, Case{"top", 99},
+        Case{"phase", 9}, Case{"bottom", -1}, Case{"shell", {123456789}}, Case{"samples", "x"}}) {
+    nlohmann::json h = header;
+    h["meta"]["lab"]["machine"][k.key] = k.value;
+    h["meta_fnv1a64"] = text_hash(h["meta"].dump());
+    const fs::path bad = dir / "bad.checkpoint";
+    std::ofstream(bad, std::ios::binary) << h.dump() << '\n' << body;
+    fs::copy(cp + ".files", bad.string() + ".files",
+             fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+    const fs::path out2 = dir / "out2";
+    EXPECT_EQ(test::run_command(test::binary() + " test " + protocol + " -o " + out2.string() +
+                                    " -q --threads 1 --resume " + bad.string(),
+                                &msg),
+              2)
+        << k.key << ": " << msg;
+    EXPECT_NE(msg.find(bad.string()), std::string::npos) << k.key << ": " << msg;
+    EXPECT_FALSE(fs::exists(out2)) << k.key;
+  }
 }
