@@ -72,8 +72,11 @@ inline std::unique_ptr<Model> driven_pair(const Vec3& a, const Vec3& b, double R
 inline std::string source_dir() {
   return ROCKLAB_SOURCE_DIR;
 }
+/// The rocklab executable under test: this build's, or $ROCKLAB_TEST_BINARY (e.g. a copy kept
+/// apart while a long fuzz run goes on and the build changes).
 inline std::string binary() {
-  return ROCKLAB_BINARY;
+  const char* env = std::getenv("ROCKLAB_TEST_BINARY");
+  return env && *env ? env : ROCKLAB_BINARY;
 }
 
 inline std::string read_file(const std::filesystem::path& p) {
@@ -145,7 +148,7 @@ inline std::unique_ptr<Model> run_scene_file(const std::string& file,
           static_cast<std::uint8_t>((s.model->balls.fixity[bc.index] | bc.fix) & ~bc.free);
     }
     for (const MethodCall& mc : st.methods)
-      s.model->apply_method(mc.model, mc.method, mc.gap_lo, mc.gap_hi, mc.element);
+      s.model->apply_method(mc.model, mc.method, mc.gap_lo, mc.gap_hi, mc.element, mc.gap_ratio);
     EXPECT_GT(st.run.cycles, 0) << "test helper runs cycle-count stages only";
     s.model->cycle(st.run.cycles);
   }

@@ -2,6 +2,7 @@
 #include "helpers.hpp"
 
 #include <filesystem>
+#include <map>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -323,4 +324,49 @@ TEST(Cli, TheUnbalancedForceStopCountsMoments) {
   const double about_centre = c["moment"].get<double>() - 0.01 * c["force"][1].get<double>();
   EXPECT_NEAR(about_centre, -0.5, 5e-3) << c.dump();
   EXPECT_GT(std::abs(c["moment"].get<double>()), 0.05) << c.dump(); // the bond carries its part
+}
+
+// Issue 16 item 7: bonds could only be made by an absolute gap. A stage's `methods` entry may give
+// `gap_ratio` instead, a fraction of each contact's radii sum: two pairs 0.5 mm apart, one of
+// 10 mm balls (0.025 of R1 + R2) and one of 1 mm balls (0.25), bonded up to 0.05: only the first.
+TEST(Cli, BondsCanBeMadeByAFractionOfTheRadiiSum) {
+  const std::string scene_text = R"({
+    "dimension": 3, "margin": 0.001,
+    "balls": [{"id": 1, "position": [0, 0, 0], "radius": 0.01, "density": 2650, "fix": "all"},
+              {"id": 2, "position": [0.0205, 0, 0], "radius": 0.01, "density": 2650, "fix": "all"},
+              {"id": 3, "position": [1, 0, 0], "radius": 0.001, "density": 2650, "fix": "all"},
+              {"id": 4, "position": [1.0025, 0, 0], "radius": 0.001, "density": 2650, "fix": "all"}],
+    "contact_models": [{"between": "ball-ball", "model": "linearpbond",
+                        "properties": {"kn": 1e6, "pb_kn": 1e12, "pb_ks": 1e12, "pb_ten": 1e8,
+                                       "pb_coh": 1e8, "bond": false}}],
+    "run": [{"cycles": 1}, {"cycles": 1, "methods": [{"model": "linearpbond", "method": "bond",
+                                                       GAP}]}]
+  })";
+  auto bonded = [&](const std::string& gap, std::string* msg) {
+    std::string text = scene_text;
+    text.replace(text.find("GAP"), 3, gap);
+    const fs::path scene = write_scene("gapratio", text);
+    const fs::path out = scratch("gapratio");
+    std::map<long, int> state;
+    if (run_command(binary() + " run " + scene.string() + " -o " + out.string() + " -q", msg) != 0)
+      return state;
+    const auto r = nlohmann::json::parse(read_file(out / "results.json"));
+    for (const auto& c : r["contacts"])
+      state[c["end1"].get<long>()] = c["state"]["pb_state"].get<int>();
+    return state;
+  };
+  std::string msg;
+  const auto by_ratio = bonded("\"gap_ratio\": 0.05", &msg);
+  ASSERT_EQ(by_ratio.size(), 2u) << msg;
+  EXPECT_EQ(by_ratio.at(1), 3);                      // bonded: 0.025 of its radii sum
+  EXPECT_EQ(by_ratio.at(3), 0);                      // not: 0.25
+  const auto by_gap = bonded("\"gap\": 0.05", &msg); // 0.05 m: both
+  ASSERT_EQ(by_gap.size(), 2u) << msg;
+  EXPECT_EQ(by_gap.at(1), 3);
+  EXPECT_EQ(by_gap.at(3), 3);
+  // Both keys, or a ratio beyond the radii sum: input errors.
+  EXPECT_TRUE(bonded("\"gap\": 0.1, \"gap_ratio\": 0.05", &msg).empty());
+  EXPECT_NE(msg.find("give either 'gap'"), std::string::npos) << msg;
+  EXPECT_TRUE(bonded("\"gap_ratio\": 2", &msg).empty());
+  EXPECT_NE(msg.find("key 'run[1].methods[0].gap_ratio'"), std::string::npos) << msg;
 }

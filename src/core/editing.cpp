@@ -62,7 +62,7 @@ std::size_t Model::add_clump(const std::vector<Pebble>& pebbles, double density,
 }
 
 std::size_t Model::apply_method(ModelKind kind, const std::string& method, double gap_lo,
-                                double gap_hi, int element) {
+                                double gap_hi, int element, bool gap_ratio) {
   std::size_t count = 0;
   visit_model(kind, [&]<class M>() {
     Batch<M>& batch = batches_.of<M>();
@@ -72,7 +72,14 @@ std::size_t Model::apply_method(ModelKind kind, const std::string& method, doubl
         continue;
       ++count;
       if constexpr (HasMethods<M>) {
-        const MethodArgs args{method, gap_lo, gap_hi, element, c.gap, outputs_[ci].force};
+        double scale = 1;
+        if (gap_ratio) {
+          scale = balls.radius[static_cast<std::size_t>(c.end1)];
+          if (c.kind == ContactKind::BallBall)
+            scale += balls.radius[static_cast<std::size_t>(c.end2)];
+        }
+        const MethodArgs args{method,  scale * gap_lo, scale * gap_hi,
+                              element, c.gap,          outputs_[ci].force};
         with_contact<M>(batch, c.slot, [&](auto&&... x) { M::call(x..., args); });
       }
       outputs_[ci].stiff = M::stiffness(batch.contacts[c.slot]);

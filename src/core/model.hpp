@@ -105,10 +105,11 @@ public:
   /// Drop the buffered events (for callers that do not read them).
   void clear_events() { pending_events_.clear(); }
   /// Call a contact-model method on every contact of one model: "bond" / "unbond" (contact gap
-  /// in [gap_lo, gap_hi]; flat joints: `element` 1..N or 0 for all) or "sj_setforce".
+  /// in [gap_lo, gap_hi]; flat joints: `element` 1..N or 0 for all) or "sj_setforce". With
+  /// `gap_ratio` the bounds are fractions of each contact's R1 + R2 (ball-facet: its ball's R).
   /// Returns the number of contacts called.
   std::size_t apply_method(ModelKind kind, const std::string& method, double gap_lo, double gap_hi,
-                           int element = 0);
+                           int element = 0, bool gap_ratio = false);
   /// Set a property of every existing contact of one model (like PFC's `contact property`):
   /// linear "fric", "kn" [N/m], "ks" [N/m]; linearpbond "fric" (its linear component);
   /// flatjoint "fj_fric"; smoothjoint "sj_fric". Returns the number of contacts changed; an

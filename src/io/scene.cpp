@@ -161,8 +161,12 @@ void read_methods(JsonObject& run, Stage& st) {
     const std::string model = mo.choice("model", model_names(ModelUse::Methods));
     mc.model = model_kind_of(model);
     mc.method = mo.choice("method", model_methods(mc.model));
-    if (mo.has("gap")) {
-      const auto& g = mo.raw("gap");
+    if (mo.has("gap") && mo.has("gap_ratio"))
+      mo.fail("gap_ratio", "give either 'gap' (m) or 'gap_ratio' (of the radii sum), not both");
+    mc.gap_ratio = mo.has("gap_ratio");
+    const std::string gkey = mc.gap_ratio ? "gap_ratio" : "gap";
+    if (mo.has(gkey)) {
+      const auto& g = mo.raw(gkey);
       if (g.is_number()) {
         mc.gap_hi = g.get<double>();
       } else if (g.is_array() && g.size() == 2 && g[0].is_number() && g[1].is_number() &&
@@ -170,8 +174,13 @@ void read_methods(JsonObject& run, Stage& st) {
         mc.gap_lo = g[0].get<double>();
         mc.gap_hi = g[1].get<double>();
       } else {
-        mo.fail("gap", "expected a maximum gap or [lo, hi] in m with lo <= hi, got " + describe(g));
+        mo.fail(gkey, std::string("expected a maximum or [lo, hi] with lo <= hi (") +
+                          (mc.gap_ratio ? "fractions of R1 + R2" : "m") + "), got " + describe(g));
       }
+      if (mc.gap_ratio && !(mc.gap_hi <= 1 && (g.is_number() || mc.gap_lo >= -1)))
+        mo.fail(gkey, "a gap ratio lies within [-1, 1] (a gap beyond the radii sum reaches past "
+                      "the neighbours), got " +
+                          describe(g));
     }
     if (mc.model == model_kind<FlatJoint>)
       mc.element = static_cast<int>(mo.integer("element", 0, 1'000'000, 0));

@@ -58,6 +58,7 @@ struct MethodCall {
   ModelKind model = model_kind<LinearPBond>;
   std::string method;
   double gap_lo = -1e300, gap_hi = 0;
+  bool gap_ratio = false; ///< the gaps are fractions of the contact's radii sum (`gap_ratio`)
   int element = 0;
 };
 

@@ -39,7 +39,7 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
           static_cast<std::uint8_t>((m.balls.fixity[bc.index] | bc.fix) & ~bc.free);
     }
     for (const MethodCall& mc : stage.methods)
-      m.apply_method(mc.model, mc.method, mc.gap_lo, mc.gap_hi, mc.element);
+      m.apply_method(mc.model, mc.method, mc.gap_lo, mc.gap_hi, mc.element, mc.gap_ratio);
     const RunSpec& run = stage.run;
     const std::int64_t step0 = m.step();
     const double time0 = m.time();
