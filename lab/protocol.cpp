@@ -41,6 +41,8 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
       p.specimen_file = resolve(file, s.string("file"));
       if (!std::filesystem::exists(p.specimen_file))
         s.fail("file", "\"" + p.specimen_file + "\" does not exist");
+      if (!not_an_input_file(p.specimen_file).empty())
+        s.fail("file", "\"" + p.specimen_file + "\" is not a specimen file");
     } else {
       p.material_file = resolve(file, s.string("material"));
       if (!std::filesystem::exists(p.material_file))

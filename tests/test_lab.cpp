@@ -702,6 +702,11 @@ TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
        "key 'loading.strain_rate': at 1e-09 1/s the 5000000 steps of 'stop.max_steps'"},
       {{{"test", "ucs"}}, "key 'specimen'"},
       {{{"test", "ucs"}, {"specimen", {{"file", "/nonexistent.rlspec"}}}}, "does not exist"},
+      // Found by the fuzz: a specimen path that is a folder or another kind of file.
+      {{{"test", "ucs"}, {"specimen", {{"file", "/tmp"}}}},
+       "key 'specimen.file': \"/tmp\" is not a specimen file"},
+      {{{"test", "ucs"}, {"specimen", {{"file", "/etc/passwd"}}}},
+       "key 'specimen.file': /etc/passwd: not a rocklab specimen file"},
       {{{"test", "triaxial"}, {"specimen", {{"file", spec}}}}, "key 'loading.confinement'"},
       {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"colour", 1}}, "unknown key 'colour'"},
       {{{"test", "brazilian"}, {"specimen", {{"file", spec}}}}, "needs a disk specimen"},
