@@ -190,9 +190,8 @@ void LoadingFrame::advance() {
       record_history();
       begin_loading();
     } else if (since > p_.max_steps) {
-      throw std::runtime_error(p_.file + ": the " + phase_name() +
-                               " phase did not reach its stress in " +
-                               std::to_string(p_.max_steps) + " steps (key 'stop.max_steps')");
+      throw InputError(p_.file + ": the " + phase_name() + " phase did not reach its stress in " +
+                       std::to_string(p_.max_steps) + " steps (key 'stop.max_steps')");
     }
     if (since % p_.history_every == 0)
       record_history();
