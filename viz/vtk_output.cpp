@@ -51,15 +51,20 @@ template <class T, class Arr> vtkNew<Arr> scalar_array(const char* name, const s
   return a;
 }
 
-void write_poly(vtkPolyData* pd, const std::filesystem::path& p) {
-  vtkObject::GlobalWarningDisplayOff(); // a failed write is our OutputError, not VTK's log
-  vtkNew<vtkXMLPolyDataWriter> w;
+// One VTK XML file (appended raw data); a failed write is our OutputError, not VTK's log.
+template <class Writer> void write_xml(vtkDataObject* data, const std::filesystem::path& p) {
+  vtkObject::GlobalWarningDisplayOff();
+  vtkNew<Writer> w;
   w->SetFileName(p.string().c_str());
-  w->SetInputData(pd);
+  w->SetInputData(data);
   w->SetDataModeToAppended();
   w->EncodeAppendedDataOff();
   if (w->Write() != 1)
     throw OutputError(p.string() + ": VTK could not write the file (disk full?)");
+}
+
+void write_poly(vtkPolyData* pd, const std::filesystem::path& p) {
+  write_xml<vtkXMLPolyDataWriter>(pd, p);
 }
 
 // Two unit vectors spanning the plane normal to n.
@@ -153,14 +158,7 @@ void write_grains(const Snapshot& s, const std::filesystem::path& path) {
   pd->AddArray(vector_array("displacement", s.disp));
   pd->AddArray(scalar_array<std::int32_t, vtkIntArray>("group", s.group));
   pd->AddArray(scalar_array<std::int64_t, vtkLongLongArray>("id", s.id));
-  vtkObject::GlobalWarningDisplayOff();
-  vtkNew<vtkXMLUnstructuredGridWriter> w;
-  w->SetFileName(path.string().c_str());
-  w->SetInputData(ug);
-  w->SetDataModeToAppended();
-  w->EncodeAppendedDataOff();
-  if (w->Write() != 1)
-    throw OutputError(path.string() + ": VTK could not write the file (disk full?)");
+  write_xml<vtkXMLUnstructuredGridWriter>(ug, path);
 }
 
 // Bonds: a line between the grain centres.
