@@ -24,21 +24,13 @@ namespace fs = std::filesystem;
 SpecimenSource obtain_specimen(const Protocol& p, const std::atomic<bool>* interrupt,
                                bool progress) {
   SpecimenSource src;
-  // A file the protocol names that turns out not to be a specimen or a card: the error says
-  // which protocol key named it.
-  auto named_by = [&](const char* key, auto&& load) {
-    try {
-      return load();
-    } catch (const InputError& e) {
-      throw InputError(p.file + ": key '" + key + "': " + e.what());
-    }
-  };
   if (!p.specimen_file.empty()) {
-    src.model = named_by("specimen.file", [&] { return load_model(p.specimen_file, &src.meta); });
+    src.model =
+        named_by(p.file, "specimen.file", [&] { return load_model(p.specimen_file, &src.meta); });
     return src;
   }
   MaterialCard card =
-      named_by("specimen.material", [&] { return load_material_card(p.material_file); });
+      named_by(p.file, "specimen.material", [&] { return load_material_card(p.material_file); });
   apply_overrides(card,
                   {{p.shape, p.file, "specimen.shape"}, {p.cut, p.file, "specimen.cut"}, p.seed});
   GenesisResult g = run_genesis(

@@ -299,6 +299,10 @@ TEST(CalibrationFile, BadFilesNameTheKeyAndWhatIsAllowed) {
   j = good_calibration();
   j["budgte"] = 3;
   EXPECT_NE(error_of(j).find("budgte"), std::string::npos) << error_of(j);
+  // A material path that is not a card is named with the calibration file's key.
+  j = good_calibration();
+  j["material"] = "/dev/zero";
+  EXPECT_NE(error_of(j).find("key 'material': /dev/zero"), std::string::npos) << error_of(j);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -190,7 +190,8 @@ CalibrationFile load_calibration(const std::string& path) {
   c.material_file = resolve(path, m);
   if (!fs::exists(c.material_file))
     top.fail("material", "\"" + c.material_file + "\" does not exist");
-  load_material_card(c.material_file); // the base card must be valid on its own
+  // The base card must be valid on its own.
+  named_by(path, "material", [&] { return load_material_card(c.material_file); });
   c.material = read_json_file(c.material_file);
   read_targets(c, top);
   JsonObject params = top.object("parameters");
