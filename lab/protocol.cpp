@@ -99,6 +99,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     p.vtk_every_strain = o.number("vtk_every_strain", Range::non_negative(), 5e-4);
     p.vtk = o.boolean("vtk", true);
     p.plots = o.boolean("plots", true);
+    p.orientation = o.boolean("orientation", false);
     o.finish();
   }
   top.finish();

@@ -50,6 +50,7 @@ struct Protocol {
   double vtk_every_strain = 5e-4;   ///< a VTK snapshot every this much axial strain (0: none)
   bool vtk = true;                  ///< write ParaView files
   bool plots = true;                ///< write the SVG stress-strain plot and crack map
+  bool orientation = false;         ///< track grain rotation from the loading on (ParaView)
   nlohmann::json raw;               ///< the file as read
   std::string text_hash;            ///< hash of the file's text
 };

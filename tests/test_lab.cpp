@@ -19,6 +19,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <regex>
 #include <sys/wait.h>
 #include <thread>
@@ -91,8 +92,11 @@ bool has(const std::vector<std::string>& v, const std::string& s) {
 
 TEST(Lab, UcsWritesResultsCracksAndReadableParaViewFiles) {
   const fs::path out = scratch("ucs");
-  const LabSummary s =
-      run("ucs", {{"test", "ucs"}, {"specimen", {{"file", specimen("lab_2d_fj")}}}}, out);
+  const LabSummary s = run("ucs",
+                           {{"test", "ucs"},
+                            {"specimen", {{"file", specimen("lab_2d_fj")}}},
+                            {"output", {{"orientation", true}}}},
+                           out);
   const nlohmann::json r = read_json_file((out / "results.json").string(), Nulls::Allow);
   EXPECT_EQ(r, s.results);
   // The results a rock engineer reads.
@@ -135,6 +139,7 @@ TEST(Lab, UcsWritesResultsCracksAndReadableParaViewFiles) {
 
   // ParaView: every file of every .pvd exists and reads back with VTK's XML readers.
   int files = 0;
+  double first_most = 0, last_most = 0; // the largest grain rotation, first and last file [rad]
   for (const char* series : {"grains", "bonds", "cracks", "walls"}) {
     const std::string pvd = test::read_file(out / "vtk" / (std::string(series) + ".pvd"));
     std::regex ref("file=\"([^\"]+)\"");
@@ -147,8 +152,17 @@ TEST(Lab, UcsWritesResultsCracksAndReadableParaViewFiles) {
       ++files;
       if (std::string(series) == "grains") {
         EXPECT_EQ(info.points, r["provenance"]["grains"].get<long long>());
-        for (const char* a : {"radius", "velocity", "displacement", "group"})
+        for (const char* a : {"radius", "velocity", "displacement", "group", "rotation"})
           EXPECT_TRUE(has(info.point_arrays, a)) << a;
+        // Grain rotations (2D: signed angle about z) count from the loading's start, like the
+        // displacements: they grow from the first frame to the last, none beyond half a turn.
+        const std::vector<double>& rot = info.point_values.at("rotation");
+        double most = 0;
+        for (double a : rot) {
+          EXPECT_LE(std::abs(a), std::numbers::pi) << f;
+          most = std::max(most, std::abs(a));
+        }
+        (n == 0 ? first_most : last_most) = most;
       } else if (std::string(series) == "bonds") {
         EXPECT_GT(info.cells, 0);
         EXPECT_EQ(info.points, 2 * info.cells);
@@ -169,6 +183,9 @@ TEST(Lab, UcsWritesResultsCracksAndReadableParaViewFiles) {
   const std::string name = pvd.substr(last + 6, pvd.find('"', last + 6) - last - 6);
   EXPECT_EQ(read_vtk_info((out / "vtk" / name).string()).cells, total);
   EXPECT_GE(files, 12);
+  std::printf("grain rotation: first frame %g rad, last %g rad\n", first_most, last_most);
+  EXPECT_GT(last_most, 10 * first_most);
+  EXPECT_GT(last_most, 1e-3);
   // Pictures without ParaView.
   for (const char* f : {"stress_strain.svg", "crack_map.svg"}) {
     const std::string svg = test::read_file(out / f);

@@ -59,6 +59,7 @@ std::unique_ptr<Model> busy_model() {
   for (const ModelRule& r : m.rules)
     rules.push_back(r); // the scene's linear rules for everything else
   m.rules = rules;
+  m.balls.track_orientation(true); // so that orientations are restored and validated too
   m.initialize();
   m.cycle(1500);
   return std::move(s.model);

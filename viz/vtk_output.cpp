@@ -87,6 +87,9 @@ Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, doubl
   s.radius = b.radius;
   s.group = b.group;
   s.id = b.id;
+  if (b.tracks_orientation())
+    for (const Eigen::Quaterniond& q : b.orient)
+      s.rotation.push_back(rotation_vector(q));
   s.disp.resize(b.size(), Vec3::Zero());
   if (reference.size() == b.size())
     for (std::size_t i = 0; i < b.size(); ++i)
@@ -158,6 +161,14 @@ void write_grains(const Snapshot& s, const std::filesystem::path& path) {
   pd->AddArray(vector_array("displacement", s.disp));
   pd->AddArray(scalar_array<std::int32_t, vtkIntArray>("group", s.group));
   pd->AddArray(scalar_array<std::int64_t, vtkLongLongArray>("id", s.id));
+  if (!s.rotation.empty()) { // 2D: the signed angle about z; 3D: the angle about the axis
+    std::vector<double> angle;
+    for (const Vec3& r : s.rotation)
+      angle.push_back(s.dim == 2 ? r.z() : r.norm());
+    pd->AddArray(scalar_array<double, vtkDoubleArray>("rotation", angle));
+    if (s.dim == 3)
+      pd->AddArray(vector_array("rotation_vector", s.rotation));
+  }
   write_xml<vtkXMLUnstructuredGridWriter>(ug, path);
 }
 
@@ -332,15 +343,18 @@ VtkFileInfo read_vtk_info(const std::string& path) {
   }
   info.points = ds->GetNumberOfPoints();
   info.cells = ds->GetNumberOfCells();
-  for (int i = 0; i < ds->GetPointData()->GetNumberOfArrays(); ++i)
-    info.point_arrays.emplace_back(ds->GetPointData()->GetArrayName(i));
-  for (int i = 0; i < ds->GetCellData()->GetNumberOfArrays(); ++i) {
-    vtkDataArray* a = ds->GetCellData()->GetArray(i);
-    info.cell_arrays.emplace_back(ds->GetCellData()->GetArrayName(i));
-    if (a && a->GetNumberOfComponents() == 1)
-      for (vtkIdType k = 0; k < a->GetNumberOfTuples(); ++k)
-        info.cell_values[info.cell_arrays.back()].push_back(a->GetTuple1(k));
-  }
+  const auto arrays = [](vtkFieldData* data, std::vector<std::string>& names,
+                         std::map<std::string, std::vector<double>>& values) {
+    for (int i = 0; i < data->GetNumberOfArrays(); ++i) {
+      vtkDataArray* a = data->GetArray(i);
+      names.emplace_back(data->GetArrayName(i));
+      if (a && a->GetNumberOfComponents() == 1)
+        for (vtkIdType k = 0; k < a->GetNumberOfTuples(); ++k)
+          values[names.back()].push_back(a->GetTuple1(k));
+    }
+  };
+  arrays(ds->GetPointData(), info.point_arrays, info.point_values);
+  arrays(ds->GetCellData(), info.cell_arrays, info.cell_values);
   return info;
 }
 

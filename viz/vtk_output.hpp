@@ -34,6 +34,9 @@ struct Snapshot {
   std::vector<double> radius;       ///< [m]
   std::vector<std::int32_t> group;
   std::vector<std::int64_t> id;
+  /// rotation since the loading began (only when the test tracks orientation, else empty) as a
+  /// rotation vector, axis * angle [rad]
+  std::vector<Vec3> rotation;
   // bonded contacts: every contact whose model has a bond (BondView), and smooth joints
   std::vector<std::array<Vec3, 2>> bond_ends; ///< the two grain centres [m]
   /// the contact model's index in the registry (1 linearpbond, 2 flatjoint, 3 smoothjoint,
@@ -82,7 +85,8 @@ private:
 struct VtkFileInfo {
   long long points = 0, cells = 0;
   std::vector<std::string> point_arrays, cell_arrays;
-  std::map<std::string, std::vector<double>> cell_values; ///< one-component cell arrays
+  std::map<std::string, std::vector<double>> point_values; ///< one-component point arrays
+  std::map<std::string, std::vector<double>> cell_values;  ///< one-component cell arrays
 };
 VtkFileInfo read_vtk_info(const std::string& path);
 

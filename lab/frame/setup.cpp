@@ -43,6 +43,7 @@ void LoadingFrame::setup() {
   measure_specimen(shape, setup.diametral);
   test_.check_shape(shape, p_);
   reference_ = m_.balls.pos;
+  m_.balls.track_orientation(p_.orientation); // rotations count from here, like displacements
   const LinearProps props = platen_contact(setup.platen_friction);
   if (setup.actuator == Actuator::Grips)
     add_grips();

@@ -32,8 +32,18 @@ struct Balls {
   std::vector<double> body_work;    ///< gravity and applied loads
   std::vector<double> gravity_work; ///< the gravity part
   std::vector<double> damping_work; ///< dissipated by local damping
+  /// Orientation of each ball's body frame relative to the global frame, integrated from the spin
+  /// (a pebble takes its clump's). Empty unless tracking is on (track_orientation): like PFC's
+  /// orientation tracking it is opt-in, as nothing in the mechanics depends on it.
+  std::vector<Eigen::Quaterniond> orient;
 
   std::size_t size() const { return pos.size(); }
+  bool tracks_orientation() const { return tracking_; }
+  /// Turn tracking on (every ball starts from the identity, i.e. "now" is the reference) or off.
+  void track_orientation(bool on) {
+    tracking_ = on;
+    orient.assign(on ? size() : 0, Eigen::Quaterniond::Identity());
+  }
 
   /// Change a radius, keeping density: mass and inertia follow.
   void set_radius(std::size_t i, double r, int dim) {
@@ -74,8 +84,13 @@ struct Balls {
     body_work.push_back(0);
     gravity_work.push_back(0);
     damping_work.push_back(0);
+    if (tracking_)
+      orient.push_back(Eigen::Quaterniond::Identity());
     return pos.size() - 1;
   }
+
+private:
+  bool tracking_ = false;
 };
 
 } // namespace rocklab

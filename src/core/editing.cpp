@@ -218,6 +218,8 @@ void Model::remove_balls(const std::vector<bool>& remove) {
   compact(balls.density), compact(balls.fixity), compact(balls.group), compact(balls.id);
   compact(balls.clump), compact(balls.body_work), compact(balls.gravity_work);
   compact(balls.damping_work);
+  if (balls.tracks_orientation())
+    compact(balls.orient);
   // Clumps go whole or stay whole; the work of what goes stays in the group totals.
   std::vector<Clump> kept_clumps;
   for (Clump& c : clumps) {

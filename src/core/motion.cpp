@@ -19,6 +19,7 @@ void Model::move_clumps(double dt, std::array<double, 4>& sums) {
   const double alpha = settings.local_damping;
   const Vec3 gvec = settings.gravity;
   const int ntran = dim == 2 ? 2 : 3;
+  const bool track = balls.tracks_orientation();
   const auto s = block_sum<4>(clumps.size(), [&](std::size_t k, std::array<double, 4>& acc) {
     Clump& c = clumps[k];
     // Resultant about the centroid: pebble contact forces and moments, gravity on the union's
@@ -51,7 +52,9 @@ void Model::move_clumps(double dt, std::array<double, 4>& sums) {
     if (dim == 2)
       c.L.x() = c.L.y() = 0;
     Vec3 Lb = c.q.conjugate() * c.L;
+    const Eigen::Quaterniond q0 = c.q;
     free_rotation(c.q, Lb, c.inertia, dt, dim);
+    const Eigen::Quaterniond turn = c.q * q0.conjugate(); // this step's rotation, global frame
     c.spin = c.q * Lb.cwiseQuotient(c.inertia);
     const Vec3 wm = 0.5 * (w0 + c.spin);
     dw -= Md.dot(wm) * dt;
@@ -65,6 +68,8 @@ void Model::move_clumps(double dt, std::array<double, 4>& sums) {
       balls.pos[i] = x;
       balls.vel[i] = c.vel + c.spin.cross(arm);
       balls.spin[i] = c.spin;
+      if (track)
+        balls.orient[i] = (turn * balls.orient[i]).normalized();
     }
     c.body_work += bw;
     c.gravity_work += gw;
@@ -82,6 +87,7 @@ void Model::law_of_motion(double dt) {
   const double alpha = settings.local_damping;
   const Vec3 gvec = settings.gravity;
   const int ntran = dim == 2 ? 2 : 3;
+  const bool track = balls.tracks_orientation();
   // acc: 0 body work, 1 gravity work, 2 boundary (constraint) work, 3 local damping, 4 max |v|
   // and 5 max displacement are handled with separate reductions below.
   auto sums = block_sum<4>(balls.size(), [&](std::size_t i, std::array<double, 4>& acc) {
@@ -124,6 +130,8 @@ void Model::law_of_motion(double dt) {
       w[d] = w1;
       bw += balls.applied_moment[i][d] * 0.5 * (w0 + w1) * dt;
     }
+    if (track) // turned by the mid-step spin, as the position is moved by the mid-step velocity
+      balls.orient[i] = turn_by(balls.orient[i], w * dt);
     const Vec3 dx = v * dt;
     balls.pos[i] += dx;
     balls.disp[i] += dx;

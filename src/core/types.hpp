@@ -24,4 +24,19 @@ inline Vec3 rotate_by(const Vec3& v, const Vec3& phi) {
   return Eigen::AngleAxisd(angle, phi / angle) * v;
 }
 
+/// Orientation q turned further by the rotation vector phi (axis * angle, global frame).
+inline Eigen::Quaterniond turn_by(const Eigen::Quaterniond& q, const Vec3& phi) {
+  const double angle = phi.norm();
+  if (angle < 1e-300)
+    return q;
+  return (Eigen::Quaterniond(Eigen::AngleAxisd(angle, phi / angle)) * q).normalized();
+}
+
+/// The rotation vector (axis * angle, angle in [0, pi]) of the orientation q; in 2D its z
+/// component is the signed angle turned about z.
+inline Vec3 rotation_vector(const Eigen::Quaterniond& q) {
+  const Eigen::AngleAxisd aa(q);
+  return aa.angle() * aa.axis();
+}
+
 } // namespace rocklab

@@ -60,6 +60,13 @@ nlohmann::json ball_json(const Model& m, std::size_t i) {
     jb["spin"] = vec_json(b.spin[i], dim);
     jb["moment"] = vec_json(b.moment[i], dim);
   }
+  if (b.tracks_orientation()) {
+    const Eigen::Quaterniond& q = b.orient[i];
+    if (dim == 2) // the angle turned about z, in [-pi, pi]
+      jb["orientation"] = rotation_vector(q).z();
+    else
+      jb["orientation"] = {q.w(), q.x(), q.y(), q.z()};
+  }
   return jb;
 }
 

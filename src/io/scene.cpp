@@ -213,6 +213,7 @@ Scene load_scene(const std::string& path) {
   }
   m.settings.timestep_safety = top.number("timestep_safety", {0, 1, true, false}, 0.8);
   m.settings.margin = top.number("margin", Range::positive(), 0.0, "m");
+  m.balls.track_orientation(top.boolean("orientation_tracking", false));
 
   read_walls(top, m);
   read_balls(top, m);

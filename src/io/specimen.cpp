@@ -21,6 +21,7 @@ static_assert(std::endian::native == std::endian::little, "specimen files are li
 struct ArchiveWriter {
   std::string bytes;
   static constexpr bool reading = false;
+  static constexpr std::uint64_t version = kSpecimenVersion;
   template <class T>
   std::enable_if_t<std::is_arithmetic_v<T> || std::is_enum_v<T>> operator()(const T& v) {
     const char* p = reinterpret_cast<const char*>(&v);
@@ -46,6 +47,7 @@ struct ArchiveReader {
   const std::string& bytes;
   std::size_t pos = 0;
   std::string file;
+  std::uint64_t version = kSpecimenVersion; ///< of the file: older ones lack the newer fields
   static constexpr bool reading = true;
   void need(std::size_t n) {
     if (n > bytes.size() - pos) // pos <= size: no wrap-around for a length near 2^64
@@ -192,6 +194,14 @@ template <class A> void Model::serialize(A& a) {
   io(a, ledger_);
   io(a, retired_);
   each(a, group_retired_), each(a, broken_);
+  if (a.version >= 7) {
+    bool track = balls.tracks_orientation();
+    a(track);
+    if constexpr (A::reading)
+      balls.track_orientation(track);
+    if (track)
+      a.vec(balls.orient, [&](Eigen::Quaterniond& q) { a(q.w()), a(q.x()), a(q.y()), a(q.z()); });
+  }
   if constexpr (A::reading) {
     if (outputs_.size() != contacts_.size())
       throw InputError("corrupt specimen body (contact arrays of different lengths)");
@@ -215,6 +225,14 @@ std::string Model::check_loaded() const {
       return "ball " + std::to_string(i) + ": group index out of range";
     if (balls.clump[i] != -1 && !in(balls.clump[i], clumps.size()))
       return "ball " + std::to_string(i) + ": clump index out of range";
+  }
+  if (balls.tracks_orientation()) {
+    if (balls.orient.size() != n)
+      return "orientations for " + std::to_string(balls.orient.size()) + " of " +
+             std::to_string(n) + " balls";
+    for (std::size_t i = 0; i < n; ++i)
+      if (!(std::abs(balls.orient[i].norm() - 1) < 1e-9))
+        return "ball " + std::to_string(i) + ": orientation is not a unit quaternion";
   }
   for (std::size_t k = 0; k < clumps.size(); ++k)
     for (std::int32_t p : clumps[k].pebbles)
@@ -309,9 +327,9 @@ std::unique_ptr<Model> load_model(const std::string& path, nlohmann::json* meta)
     return header[key].get<std::uint64_t>();
   };
   const std::uint64_t version = header_number("version");
-  if (version != kSpecimenVersion && version != 5)
+  if (version < 5 || version > static_cast<std::uint64_t>(kSpecimenVersion))
     throw InputError(path + ": key 'version': value " + std::to_string(version) +
-                     " is not supported (this rocklab reads versions 5 and " +
+                     " is not supported (this rocklab reads versions 5 to " +
                      std::to_string(kSpecimenVersion) + ")");
   const std::uint64_t body_bytes = header_number("body_bytes");
   const std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -336,7 +354,7 @@ std::unique_ptr<Model> load_model(const std::string& path, nlohmann::json* meta)
       throw InputError(path + ": key 'meta' does not match its checksum (key 'meta_fnv1a64'): "
                               "the file was changed or damaged after rocklab wrote it");
   }
-  ArchiveReader r{body, 0, path};
+  ArchiveReader r{body, 0, path, version};
   auto m = std::make_unique<Model>();
   try {
     m->serialize(r);

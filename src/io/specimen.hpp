@@ -14,9 +14,11 @@
 
 namespace rocklab {
 
-/// 6: the header carries the body's checksum (`body_fnv1a64`); version 5 files (no checksum) are
-/// still read, field by field validated like every file.
-inline constexpr int kSpecimenVersion = 6;
+/// 6: the header carries the body's checksum (`body_fnv1a64`). 7: the body ends with the balls'
+/// orientations (a tracking flag, then one quaternion per ball when it is on). Versions 5 (no
+/// checksum) and 6 are still read, as models without orientation tracking, and every version is
+/// validated field by field.
+inline constexpr int kSpecimenVersion = 7;
 
 /// Write atomically (temporary file, then rename). Throws std::runtime_error naming the file.
 void save_model(const Model& m, const std::string& path, const nlohmann::json& meta = {});
