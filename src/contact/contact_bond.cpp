@@ -11,7 +11,8 @@ ContactBond::Contact ContactBond::make(const Props& p, const CreationInfo& ci) {
   c.lin.p.lin_mode = 0; // the bond's normal force is the absolute spring force
   c.tenf = p.cb_tenf;
   c.shearf = p.cb_shearf;
-  if (p.bond && gap >= p.bond_gap_lo && gap <= p.bond_gap_hi)
+  const double s = bond_gap_scale(ci, p.bond_gap_ratio);
+  if (p.bond && gap >= s * p.bond_gap_lo && gap <= s * p.bond_gap_hi)
     c.state = BondState::Bonded;
   return c;
 }
@@ -37,7 +38,8 @@ ContactBond::Props ContactBond::read(JsonObject& p, int) {
   cb.linear = linear::read_props(p, false);
   cb.cb_tenf = p.number("cb_tenf", Range::non_negative(), 0.0, "N");
   cb.cb_shearf = p.number("cb_shearf", Range::non_negative(), 0.0, "N");
-  read_bond_option(p, true, cb.bond, cb.bond_gap_lo, cb.bond_gap_hi);
+  const BondOption b = read_bond_option(p, true);
+  cb.bond = b.bond, cb.bond_gap_lo = b.lo, cb.bond_gap_hi = b.hi, cb.bond_gap_ratio = b.ratio;
   return cb;
 }
 

@@ -22,6 +22,7 @@ struct ContactBondProps {
   double cb_shearf = 0; ///< shear bond strength [N]
   bool bond = true;     ///< bond when the contact is created (if the gap is within the range)
   double bond_gap_lo = -1e300, bond_gap_hi = 0; ///< [m]
+  bool bond_gap_ratio = false; ///< lo, hi are fractions of R1 + R2 (specimen version >= 7)
 };
 
 struct ContactBondContact {
@@ -102,6 +103,8 @@ struct ContactBond {
   template <class A> static void io(A& a, Props& p) {
     Linear::io(a, p.linear);
     a(p.cb_tenf), a(p.cb_shearf), a(p.bond), a(p.bond_gap_lo), a(p.bond_gap_hi);
+    if (a.version >= 7)
+      a(p.bond_gap_ratio);
   }
   template <class A> static void io(A& a, Contact& c) {
     Linear::io(a, c.lin);

@@ -171,9 +171,23 @@ inline void inherit_minimum(double& mu, double m1, double m2) {
     mu = std::min(m1, m2); // Eq. 19
 }
 
-/// The `bond` key of a bonded model's properties: true/false, a maximum gap [m], or
-/// {"gap": [lo, hi]}; absent: `default_bond` with the gap range (-inf, 0] (model_json.cpp).
-void read_bond_option(JsonObject& p, bool default_bond, bool& bond, double& lo, double& hi);
+/// The `bond` key of a bonded model's properties: whether a new contact is bonded, and for which
+/// creation gaps [lo, hi]: in metres, or with `ratio` as fractions of the radii sum.
+struct BondOption {
+  bool bond = false;
+  double lo = -1e300, hi = 0;
+  bool ratio = false;
+};
+/// Reads `bond`: true/false (the gaps (-inf, default_hi]), a maximum gap [m], {"gap": [lo, hi]}
+/// in m or {"gap_ratio": [lo, hi]} as fractions of R1 + R2 within [-1, 1]; absent:
+/// `default_bond` (model_json.cpp).
+BondOption read_bond_option(JsonObject& p, bool default_bond, double default_hi = 0);
+
+/// What a creation gap is measured against: 1 (metres) or, for a `gap_ratio` range, the radii
+/// sum R1 + R2 (a ball-facet contact: R1), as the run-stage methods' `gap_ratio` does.
+inline double bond_gap_scale(const CreationInfo& ci, bool ratio) {
+  return ratio ? ci.R1 + ci.R2 : 1.0;
+}
 
 /// A method called on existing contacts of one model (scene `methods`).
 struct MethodArgs {

@@ -114,9 +114,11 @@ FlatJoint::Contact FlatJoint::make(const Props& p, const CreationInfo& ci, Pool&
   c.n_elem = static_cast<std::uint16_t>(c.geo->A.size());
   elements.resize(elements.size() + c.n_elem); // Eq. 29: all element forces zero
   std::span<FlatJointElement> e(elements.data() + c.elem, c.n_elem);
-  if (p.bond)
+  const double s = bond_gap_scale(ci, p.bond_gap_ratio);
+  const bool bonded = p.bond && ci.gap >= s * p.bond_gap_lo && ci.gap <= s * p.bond_gap_hi;
+  if (bonded)
     bond(c, e);
-  c.mtype = c.gap0 > 0 ? 2 : (p.bond ? 1 : 3);
+  c.mtype = c.gap0 > 0 ? 2 : (bonded ? 1 : 3);
   return c;
 }
 
@@ -428,8 +430,9 @@ FlatJoint::Props FlatJoint::read(JsonObject& p, int dim) {
   fj.fj_exact = p.boolean("fj_exact", false);
   if (dim == 2 && fj.fj_exact)
     p.fail("fj_exact", "is a 3D option (the 2D element integrals are always exact)");
-  double lo, hi;
-  read_bond_option(p, false, fj.bond, lo, hi);
+  // true bonds every new contact whatever its gap (the elements' own gap is fj_gap0)
+  const BondOption b = read_bond_option(p, false, 1e300);
+  fj.bond = b.bond, fj.bond_gap_lo = b.lo, fj.bond_gap_hi = b.hi, fj.bond_gap_ratio = b.ratio;
   if (fj.bond && fj.fj_gap0 > 0)
     p.fail("bond", "only elements with a zero gap can be bonded, but fj_gap0 > 0");
   return fj;

@@ -31,6 +31,9 @@ struct FlatJointProps {
   double fj_kratio = 0;  ///< kappa* = kn/ks for the deformability method
   bool bond = false;     ///< apply the bond method (all elements) when the contact is created
   bool fj_exact = false; ///< 3D: integrate element normal and twist-shear stresses exactly
+  /// ... if its creation gap is in [lo, hi]: m, or fractions of R1 + R2 (file version >= 7)
+  double bond_gap_lo = -1e300, bond_gap_hi = 1e300;
+  bool bond_gap_ratio = false;
 };
 
 /// Element state (memo Table 4, per element).
@@ -150,6 +153,8 @@ struct FlatJoint {
     a(p.fj_Nr), a(p.fj_Nal), a(p.fj_rmul), a(p.fj_gap0), a(p.fj_kn), a(p.fj_ks), a(p.fj_fric),
         a(p.fj_ten), a(p.fj_coh), a(p.fj_fa), a(p.fj_emod), a(p.fj_kratio), a(p.bond),
         a(p.fj_exact);
+    if (a.version >= 7)
+      a(p.bond_gap_lo), a(p.bond_gap_hi), a(p.bond_gap_ratio);
   }
   template <class A> static void io(A& a, Contact& c) {
     a(c.kn), a(c.ks), a(c.fric), a(c.ten), a(c.coh), a(c.tan_fa), a(c.rmul), a(c.gap0);

@@ -57,8 +57,10 @@ LinearPBond::Contact LinearPBond::make(const Props& p, const CreationInfo& ci) {
   c.p.ten = p.pb_ten;
   c.p.coh = p.pb_coh;
   c.p.tan_fa = std::tan(p.pb_fa * std::numbers::pi / 180.0);
-  if (p.bond)
-    bond(c, ci.gap, p.bond_gap_lo, p.bond_gap_hi);
+  if (p.bond) {
+    const double s = bond_gap_scale(ci, p.bond_gap_ratio);
+    bond(c, ci.gap, s * p.bond_gap_lo, s * p.bond_gap_hi);
+  }
   const BondSection b = bond_section(c.p.rmul, dim, R1, R2, ball_facet);
   c.s.R = b.R;
   c.s.A = b.A;
@@ -185,7 +187,8 @@ LinearPBond::Props LinearPBond::read(JsonObject& p, int) {
   pb.pb_ten = p.number("pb_ten", Range::non_negative(), 0.0, "Pa");
   pb.pb_coh = p.number("pb_coh", Range::non_negative(), 0.0, "Pa");
   pb.pb_fa = p.number("pb_fa", Range::half_open(0, 90), 0.0, "deg");
-  read_bond_option(p, true, pb.bond, pb.bond_gap_lo, pb.bond_gap_hi);
+  const BondOption b = read_bond_option(p, true);
+  pb.bond = b.bond, pb.bond_gap_lo = b.lo, pb.bond_gap_hi = b.hi, pb.bond_gap_ratio = b.ratio;
   return pb;
 }
 

@@ -20,6 +20,7 @@ struct LinearPBondProps {
   double pb_kratio = 0; ///< kappa-bar* for pb_deformability [-]
   bool bond = true;     ///< apply the bond method when the contact is created
   double bond_gap_lo = -1e300, bond_gap_hi = 0; ///< bond if g_c is in [lo, hi] [m]
+  bool bond_gap_ratio = false; ///< lo, hi are fractions of R1 + R2 (specimen version >= 7)
 };
 
 struct LinearPBondParams {
@@ -94,6 +95,8 @@ struct LinearPBond {
     Linear::io(a, p.linear);
     a(p.pb_rmul), a(p.pb_kn), a(p.pb_ks), a(p.pb_mcf), a(p.pb_ten), a(p.pb_coh), a(p.pb_fa),
         a(p.pb_emod), a(p.pb_kratio), a(p.bond), a(p.bond_gap_lo), a(p.bond_gap_hi);
+    if (a.version >= 7)
+      a(p.bond_gap_ratio);
   }
   template <class A> static void io(A& a, Contact& c) {
     Linear::io(a, c.lp), Linear::io(a, c.ls);

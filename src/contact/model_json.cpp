@@ -4,29 +4,34 @@
 
 namespace rocklab {
 
-void read_bond_option(JsonObject& p, bool default_bond, bool& bond, double& lo, double& hi) {
-  bond = default_bond;
-  lo = -1e300;
-  hi = 0;
+BondOption read_bond_option(JsonObject& p, bool default_bond, double default_hi) {
+  BondOption b{default_bond, -1e300, default_hi, false};
   if (!p.has("bond"))
-    return;
+    return b;
   const auto& v = p.raw("bond");
+  const auto range = [&](const char* key, double limit) {
+    if (!v.is_object() || v.size() != 1 || !v.contains(key))
+      return false;
+    const auto& r = v[key];
+    return r.is_array() && r.size() == 2 && r[0].is_number() && r[1].is_number() &&
+           r[0].get<double>() <= r[1].get<double>() && r[0].get<double>() >= -limit &&
+           r[1].get<double>() <= limit;
+  };
   if (v.is_boolean()) {
-    bond = v.get<bool>();
+    b.bond = v.get<bool>();
   } else if (v.is_number()) {
-    bond = true;
-    hi = v.get<double>();
-  } else if (v.is_object() && v.size() == 1 && v.contains("gap") && v["gap"].is_array() &&
-             v["gap"].size() == 2 && v["gap"][0].is_number() && v["gap"][1].is_number() &&
-             v["gap"][0].get<double>() <= v["gap"][1].get<double>()) {
-    bond = true;
-    lo = v["gap"][0].get<double>();
-    hi = v["gap"][1].get<double>();
+    b = {true, -1e300, v.get<double>(), false};
+  } else if (range("gap", 1e300)) {
+    b = {true, v["gap"][0].get<double>(), v["gap"][1].get<double>(), false};
+  } else if (range("gap_ratio", 1)) {
+    b = {true, v["gap_ratio"][0].get<double>(), v["gap_ratio"][1].get<double>(), true};
   } else {
-    p.fail("bond", "expected true/false, a maximum gap in m, or {\"gap\": [lo, hi]} with "
-                   "lo <= hi, got " +
+    p.fail("bond", "expected true/false, a maximum gap in m, {\"gap\": [lo, hi]} in m or "
+                   "{\"gap_ratio\": [lo, hi]} as fractions of the radii sum within [-1, 1], "
+                   "with lo <= hi, got " +
                        describe(v));
   }
+  return b;
 }
 
 std::vector<std::string> model_names(ModelUse use) {

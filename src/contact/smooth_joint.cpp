@@ -43,8 +43,10 @@ SmoothJoint::Contact SmoothJoint::make(const Props& p, const CreationInfo& ci) {
   // Piece 2 lies in surface 2 iff n_c . n_j >= 0; orient n_j from piece 1's surface to 2's.
   const Vec3 nj = p.use_normal ? Vec3(p.normal.normalized()) : joint_normal(dim, p.dip, p.ddir);
   c.nj = n_c.dot(nj) >= 0 ? nj : Vec3(-nj);
-  if (p.bond)
-    bond(c, ci.gap, p.bond_gap_lo, p.bond_gap_hi);
+  if (p.bond) {
+    const double s = bond_gap_scale(ci, p.bond_gap_ratio);
+    bond(c, ci.gap, s * p.bond_gap_lo, s * p.bond_gap_hi);
+  }
   return c;
 }
 
@@ -188,7 +190,8 @@ SmoothJoint::Props SmoothJoint::read(JsonObject& p, int dim) {
     if (dim == 2 && p.has("ddir"))
       p.fail("ddir", "is a 3D property");
   }
-  read_bond_option(p, false, sj.bond, sj.bond_gap_lo, sj.bond_gap_hi);
+  const BondOption b = read_bond_option(p, false);
+  sj.bond = b.bond, sj.bond_gap_lo = b.lo, sj.bond_gap_hi = b.hi, sj.bond_gap_ratio = b.ratio;
   return sj;
 }
 

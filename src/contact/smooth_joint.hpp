@@ -26,6 +26,7 @@ struct SmoothJointProps {
   Vec3 normal = Vec3::UnitZ();
   bool bond = false;                            ///< apply the bond method at creation
   double bond_gap_lo = -1e300, bond_gap_hi = 0; ///< bond if g_c lies in [lo, hi] [m]
+  bool bond_gap_ratio = false; ///< lo, hi are fractions of R1 + R2 (specimen version >= 7)
 };
 
 struct SmoothJointContact {
@@ -116,6 +117,8 @@ struct SmoothJoint {
     a(p.sj_kn), a(p.sj_ks), a(p.sj_fric), a(p.sj_da), a(p.sj_ten), a(p.sj_coh), a(p.sj_fa),
         a(p.sj_rmul), a(p.sj_large), a(p.dip), a(p.ddir), a(p.use_normal), a(p.normal), a(p.bond),
         a(p.bond_gap_lo), a(p.bond_gap_hi);
+    if (a.version >= 7)
+      a(p.bond_gap_ratio);
   }
   template <class A> static void io(A& a, Contact& c) {
     a(c.kn), a(c.ks), a(c.fric), a(c.tan_da), a(c.ten), a(c.coh), a(c.tan_fa), a(c.rmul),
