@@ -159,6 +159,13 @@ std::vector<Seed> fuzz_seeds(const fs::path& dir) {
         "examples/verification/methods_bond_unbond.json",
         "examples/verification/interlocked_2d.json"})
     seeds.push_back({"run", read(scene), {}});
+  { // the opt-in keys too: orientation tracking, bonds by a fraction of the radii sum
+    nlohmann::ordered_json j =
+        nlohmann::ordered_json::parse(read("examples/verification/methods_bond_unbond.json"));
+    j["orientation_tracking"] = true;
+    j["contact_models"][0]["properties"]["bond"] = {{"gap_ratio", {-0.01, 0.01}}};
+    seeds.push_back({"run", j.dump(1), {}});
+  }
   for (const char* card : {"tests/data/lab_2d_fj.json", "tests/data/genesis_2d_rect_pb.json",
                            "tests/data/genesis_3d_prism.json", "materials/granite_fj_2d.json",
                            "materials/berea_cb_2d.json", "materials/granite_fj_3d.json"})
@@ -183,6 +190,8 @@ std::vector<Seed> fuzz_seeds(const fs::path& dir) {
       p["loading"]["confinement"] = 1e6;
     if (std::string(t) == "brazilian")
       p["specimen"] = {{"material", src + "/tests/data/genesis_2d_disk.json"}};
+    if (std::string(t) == "ucs" || std::string(t) == "brazilian")
+      p["output"]["orientation"] = true;
     seeds.push_back({"test", p.dump(1), {}});
   }
   for (const char* c : {"lab/calibrate/lac_du_bonnet_2d.json", "lab/calibrate/berea.json"}) {
