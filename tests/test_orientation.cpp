@@ -16,8 +16,10 @@ using rocklab::test::near_rel;
 
 namespace {
 
-// One ball spinning freely (no contacts, no gravity, no damping).
-std::unique_ptr<Model> spinning_ball(int dim, const Vec3& spin, bool track) {
+// One ball spinning freely (no contacts, no gravity, no damping), and optionally a second one
+// far away spinning at `spin2`.
+std::unique_ptr<Model> spinning_ball(int dim, const Vec3& spin, bool track,
+                                     const Vec3* spin2 = nullptr) {
   auto m = std::make_unique<Model>();
   m->settings.dim = dim;
   m->settings.local_damping = 0;
@@ -25,6 +27,8 @@ std::unique_ptr<Model> spinning_ball(int dim, const Vec3& spin, bool track) {
   const std::size_t b = m->balls.add(dim, 1, Vec3::Zero(), 0.01, 2600, m->group_index("rock"));
   m->balls.spin[b] = spin;
   m->balls.vel[b] = dim == 2 ? Vec3(0.2, -0.1, 0) : Vec3(0.2, -0.1, 0.05);
+  if (spin2)
+    m->balls.spin[m->balls.add(dim, 2, Vec3(1, 0, 0), 0.01, 2600, 0)] = *spin2;
   m->balls.track_orientation(track);
   m->initialize();
   return m;
@@ -106,9 +110,8 @@ TEST(Orientation, PebblesTurnWithTheirClumpAndRotatedModelsGiveRotatedRotations)
 }
 
 TEST(Orientation, SurvivesSpecimenFilesAndRemovalAndOlderFilesLoadWithoutIt) {
-  auto m = spinning_ball(3, Vec3(1, 2, 3), true);
-  m->balls.add(3, 2, Vec3(1, 0, 0), 0.01, 2600, 0);
-  m->balls.spin[1] = Vec3(-3, 0, 1);
+  const Vec3 spin2(-3, 0, 1);
+  auto m = spinning_ball(3, Vec3(1, 2, 3), true, &spin2);
   m->cycle(200);
   const fs::path file = test::scratch_root() / "rocklab-orientation.rlspec";
   save_model(*m, file.string());

@@ -72,11 +72,11 @@ void LoadingFrame::check_reachable_strain() const {
       2 * v_final_ * m_.timestep() * static_cast<double>(p_.max_steps) / geo_.loaded_length();
   if (reach >= 1e-4)
     return;
+  const bool by_velocity = p_.platen_velocity > 0; // else by strain rate
   std::ostringstream msg;
-  msg << p_.file << ": key '"
-      << (p_.platen_velocity > 0 ? "loading.platen_velocity" : "loading.strain_rate") << "': at "
-      << (p_.platen_velocity > 0 ? p_.platen_velocity : p_.strain_rate)
-      << (p_.platen_velocity > 0 ? " m/s" : " 1/s") << " the " << p_.max_steps
+  msg << p_.file << ": key '" << (by_velocity ? "loading.platen_velocity" : "loading.strain_rate")
+      << "': at " << (by_velocity ? p_.platen_velocity : p_.strain_rate)
+      << (by_velocity ? " m/s" : " 1/s") << " the " << p_.max_steps
       << " steps of 'stop.max_steps' (time step " << m_.timestep()
       << " s) reach an axial strain of " << reach
       << "; allowed: a rate and step limit that reach at least 1e-4";

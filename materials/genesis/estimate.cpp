@@ -2,6 +2,7 @@
 // and the cards that cannot finish (a specimen narrower than two grains, more grains than memory
 // holds, an installation strain below what positions resolve, a bonding gap wider than a grain),
 // refused with the key that says so (exit 2) instead of cycling or allocating without bound.
+#include "contact/linear.hpp"
 #include "materials/genesis/stages.hpp"
 
 #include "io/input_error.hpp"
@@ -121,7 +122,7 @@ GenesisEstimate estimate_genesis(const MaterialCard& c) {
                num(kMaxGrains) + " grains within 80 % of this " + "machine's " + num(ram / 1e9) +
                " GB (a smaller specimen or larger grains)");
   // The installation pressure over the grains' modulus (2D: per unit thickness).
-  const double area = c.dim == 2 ? 2 * r_avg : std::numbers::pi * r_avg * r_avg;
+  const double area = linear::deformability_area(c.dim, r_avg);
   const double modulus = c.linear.emod > 0 ? c.linear.emod : c.linear.kn * 2 * r_avg / area;
   const double strain = c.pressure / modulus;
   const std::string mkey = c.linear.emod > 0 ? "linear.emod" : "linear.kn";

@@ -1,16 +1,14 @@
 // Genesis stage "packing": the packing contacts (linear springs at the card's stiffness for the
 // mean grain size, softened for compaction, frictionless at first) and the cloud relaxed until its
 // overlaps are small.
+#include "contact/linear.hpp"
 #include "materials/genesis/stages.hpp"
 
 #include <algorithm>
-#include <numbers>
 
 namespace rocklab::genesis {
 
 namespace {
-
-constexpr double kPi = std::numbers::pi;
 
 double max_overlap_ratio(const Model& m) {
   double worst = 0;
@@ -42,7 +40,7 @@ void relax_cloud(Run& g) {
   // frictionless.
   LinearProps pack;
   if (card.linear.emod > 0) {
-    const double area = dim == 2 ? 2 * r_avg : kPi * r_avg * r_avg;
+    const double area = linear::deformability_area(dim, r_avg);
     pack.kn = area * card.linear.emod / (2 * r_avg);
     pack.ks = card.linear.kratio > 0 ? pack.kn / card.linear.kratio : 0;
   } else {
@@ -55,7 +53,7 @@ void relax_cloud(Run& g) {
   // would make it slow); the card's stiffness is installed once the porosity is locked.
   g.stiff = pack;
   {
-    const double area = dim == 2 ? 2 * r_avg : kPi * r_avg * r_avg;
+    const double area = linear::deformability_area(dim, r_avg);
     const double e_equiv = pack.kn * 2 * r_avg / area;
     const double f = std::min(1.0, card.pressure / (card.compaction_strain * e_equiv));
     pack.kn *= f;

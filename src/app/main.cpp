@@ -300,6 +300,13 @@ const CLI::Validator kSeed(
 // Parse; -1 to go on, else the exit status: 0 after --help or --version, 2 for a bad command line
 // (an input error like any other; CLI11's own codes run from 100 up), with the usage when no
 // subcommand was given.
+// The options a command takes besides its own: --threads (OpenMP threads) and -q.
+void add_run_options(CLI::App* command, int& threads, bool& quiet,
+                     const std::string& threads_help = "Number of OpenMP threads") {
+  command->add_option("--threads", threads, threads_help)->check(CLI::NonNegativeNumber);
+  command->add_flag("-q,--quiet", quiet, "No progress and no summary");
+}
+
 int parse_command_line(CLI::App& app, int argc, char** argv) {
   try {
     app.parse(argc, argv);
@@ -331,8 +338,7 @@ int main(int argc, char** argv) {
              "OUT/history.csv");
   run->add_option("scene", scene_file, "Scene file (JSON)")->required();
   run->add_option("-o,--out", out_dir, "Output directory")->required();
-  run->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
-  run->add_flag("-q,--quiet", quiet, "No progress line and no summary");
+  add_run_options(run, threads, quiet);
 
   std::string material_file, specimen_out;
   CLI::App* gen = app.add_subcommand(
@@ -340,8 +346,7 @@ int main(int argc, char** argv) {
                  "SPECIMEN and SPECIMEN.report.json");
   gen->add_option("material", material_file, "Material card (JSON)")->required();
   gen->add_option("-o,--out", specimen_out, "Specimen file to write")->required();
-  gen->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
-  gen->add_flag("-q,--quiet", quiet, "No progress and no summary");
+  add_run_options(gen, threads, quiet);
   std::string gen_shape, gen_cut;
   std::int64_t gen_seed = -1;
   gen->add_option("--shape", gen_shape,
@@ -363,8 +368,7 @@ int main(int argc, char** argv) {
                    "Write OUT.checkpoint every N steps (and on Ctrl-C)")
       ->check(CLI::NonNegativeNumber);
   test->add_option("--resume", resume, "Continue from a checkpoint of this protocol");
-  test->add_option("--threads", threads, "Number of OpenMP threads")->check(CLI::NonNegativeNumber);
-  test->add_flag("-q,--quiet", quiet, "No progress and no summary");
+  add_run_options(test, threads, quiet);
 
   std::string suite_file, suite_out;
   CLI::App* suite = app.add_subcommand(
@@ -373,9 +377,7 @@ int main(int argc, char** argv) {
                "OUT/tests/NAME/");
   suite->add_option("suite", suite_file, "Suite file (JSON)")->required();
   suite->add_option("-o,--out", suite_out, "Output directory")->required();
-  suite->add_option("--threads", threads, "OpenMP threads per test process")
-      ->check(CLI::NonNegativeNumber);
-  suite->add_flag("-q,--quiet", quiet, "No progress and no summary");
+  add_run_options(suite, threads, quiet, "OpenMP threads per test process");
 
   CalibrateArgs cal;
   CLI::App* calib = add_calibrate(app, cal, quiet);

@@ -18,8 +18,7 @@ LinearParams make_params(const LinearProps& p, const CreationInfo& ci) {
   q.ks = p.ks;
   if (p.emod > 0) {
     const double r = ball_facet ? R1 : std::min(R1, R2);
-    const double area =
-        p.user_area > 0 ? p.user_area : (dim == 2 ? 2.0 * r : std::numbers::pi * r * r);
+    const double area = p.user_area > 0 ? p.user_area : deformability_area(dim, r);
     const double L = ball_facet ? R1 : R1 + R2;
     q.kn = area * p.emod / L;
     q.ks = p.kratio > 0 ? q.kn / p.kratio : 0.0;

@@ -6,6 +6,7 @@
 #include "contact/contact_model.hpp"
 
 #include <cstdint>
+#include <numbers>
 #include <string_view>
 
 namespace rocklab {
@@ -51,6 +52,12 @@ struct LinearContact {
 };
 
 namespace linear {
+
+/// The contact area of the deformability method for a grain of radius r [m]: a strip 2r of unit
+/// thickness in 2D, a disk pi r^2 in 3D [m^2 per m in 2D, m^2 in 3D].
+inline double deformability_area(int dim, double r) {
+  return dim == 2 ? 2.0 * r : std::numbers::pi * r * r;
+}
 
 /// Per-contact parameters from the assigned properties. With E* > 0 the deformability method sets
 /// kn = A E* / L, ks = kn / kappa* (kappa* = 0 gives ks = 0), A = 2 r (2D, unit thickness) or

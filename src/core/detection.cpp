@@ -95,16 +95,15 @@ detail::CellGrid Model::bin_balls() {
   const double max_cells = static_cast<double>(std::max<std::size_t>(8 * n, 64));
   if (n > 0 && !std::isfinite((hi - lo).maxCoeff()))
     throw PhysicsError("the balls span more than a double can hold (over 1.8e308 m)");
-  for (;;) {
-    double count = 1;
+  for (;; g.cell *= 1.25) { // (a few hundred rounds at most, even for 1e300 m)
+    double count = 1, per_axis[3] = {1, 1, 1};
     for (int d = 0; d < g.dim; ++d)
-      count *= std::floor((hi[d] - lo[d]) / g.cell) + 1;
-    if (count <= max_cells) {
+      count *= per_axis[d] = std::floor((hi[d] - lo[d]) / g.cell) + 1;
+    if (count <= max_cells) { // then each axis count fits an int64 exactly
       for (int d = 0; d < g.dim; ++d)
-        g.nc[d] = static_cast<std::int64_t>((hi[d] - lo[d]) / g.cell) + 1;
+        g.nc[d] = static_cast<std::int64_t>(per_axis[d]);
       break;
     }
-    g.cell *= 1.25; // (a few hundred rounds at most, even for 1e300 m)
   }
   // Counting sort of the balls by cell.
   const std::size_t ncells = g.cells();

@@ -57,6 +57,18 @@ void write_file(const fs::path& p, const std::function<void(std::ostream&)>& wri
     throw OutputError(p.string() + ": write failed: " + std::strerror(errno));
 }
 
+void write_file_atomically(const fs::path& p, const std::function<void(std::ostream&)>& write) {
+  const fs::path tmp = p.string() + ".partial";
+  try {
+    write_file(tmp, write);
+  } catch (const OutputError&) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
+  }
+  fs::rename(tmp, p);
+}
+
 void write_text_file(const fs::path& p, const std::string& text) {
   write_file(p, [&](std::ostream& out) { out << text; });
 }

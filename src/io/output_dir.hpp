@@ -38,6 +38,10 @@ private:
 /// Write a file by handing its stream to `write`; throws OutputError naming the file when
 /// it cannot be opened or the write fails (disk full).
 void write_file(const std::filesystem::path& p, const std::function<void(std::ostream&)>& write);
+/// write_file to PATH.partial, then rename it to PATH: readers never see half a file, and a failed
+/// write leaves nothing behind (the old PATH, if any, stays).
+void write_file_atomically(const std::filesystem::path& p,
+                           const std::function<void(std::ostream&)>& write);
 /// Write text to a file (write_file).
 void write_text_file(const std::filesystem::path& p, const std::string& text);
 

@@ -5,7 +5,6 @@
 
 #include <array>
 #include <bit>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -286,23 +285,10 @@ void save_model(const Model& m, const std::string& path, const nlohmann::json& m
                         {"body_fnv1a64", text_hash(w.bytes)},
                         {"meta_fnv1a64", text_hash(meta.dump())},
                         {"meta", meta}};
-  const std::filesystem::path target(path);
-  const std::filesystem::path tmp = target.string() + ".partial";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out)
-      throw OutputError(path + ": cannot open for writing: " + std::strerror(errno));
+  write_file_atomically(path, [&](std::ostream& out) {
     out << header.dump() << '\n';
     out.write(w.bytes.data(), static_cast<std::streamsize>(w.bytes.size()));
-    out.close();
-    if (!out) {
-      const int err = errno;
-      std::error_code ec;
-      std::filesystem::remove(tmp, ec);
-      throw OutputError(path + ": write failed: " + std::strerror(err));
-    }
-  }
-  std::filesystem::rename(tmp, target);
+  });
 }
 
 std::unique_ptr<Model> load_model(const std::string& path, nlohmann::json* meta) {
