@@ -326,34 +326,49 @@ TEST(Cli, TheUnbalancedForceStopCountsMoments) {
   EXPECT_GT(std::abs(c["moment"].get<double>()), 0.05) << c.dump(); // the bond carries its part
 }
 
-// Issue 16 item 7: bonds could only be made by an absolute gap. A stage's `methods` entry may give
-// `gap_ratio` instead, a fraction of each contact's radii sum: two pairs 0.5 mm apart, one of
-// 10 mm balls (0.025 of R1 + R2) and one of 1 mm balls (0.25), bonded up to 0.05: only the first.
-TEST(Cli, BondsCanBeMadeByAFractionOfTheRadiiSum) {
-  const std::string scene_text = R"({
+namespace {
+
+// Two pairs of fixed balls 0.5 mm apart: one of 10 mm balls (gap 0.025 of R1 + R2, ids 1-2) and
+// one of 1 mm balls (0.25, ids 3-4), with `contacts` as the scene's contact_models and `run` as
+// its run. Returns each pair's `key` contact state in results.json by its first ball's id; empty
+// when the run fails (its output in `msg`).
+std::map<long, int> pair_states(const std::string& contacts, const std::string& run,
+                                const char* key, std::string* msg) {
+  const std::string text = R"({
     "dimension": 3, "margin": 0.001,
     "balls": [{"id": 1, "position": [0, 0, 0], "radius": 0.01, "density": 2650, "fix": "all"},
               {"id": 2, "position": [0.0205, 0, 0], "radius": 0.01, "density": 2650, "fix": "all"},
               {"id": 3, "position": [1, 0, 0], "radius": 0.001, "density": 2650, "fix": "all"},
               {"id": 4, "position": [1.0025, 0, 0], "radius": 0.001, "density": 2650, "fix": "all"}],
-    "contact_models": [{"between": "ball-ball", "model": "linearpbond",
-                        "properties": {"kn": 1e6, "pb_kn": 1e12, "pb_ks": 1e12, "pb_ten": 1e8,
-                                       "pb_coh": 1e8, "bond": false}}],
-    "run": [{"cycles": 1}, {"cycles": 1, "methods": [{"model": "linearpbond", "method": "bond",
-                                                       GAP}]}]
-  })";
-  auto bonded = [&](const std::string& gap, std::string* msg) {
-    std::string text = scene_text;
-    text.replace(text.find("GAP"), 3, gap);
-    const fs::path scene = write_scene("gapratio", text);
-    const fs::path out = scratch("gapratio");
-    std::map<long, int> state;
-    if (run_command(binary() + " run " + scene.string() + " -o " + out.string() + " -q", msg) != 0)
-      return state;
-    const auto r = nlohmann::json::parse(read_file(out / "results.json"));
-    for (const auto& c : r["contacts"])
-      state[c["end1"].get<long>()] = c["state"]["pb_state"].get<int>();
+    "contact_models": )" + contacts +
+                           R"(,
+    "run": )" + run + "}";
+  const fs::path scene = write_scene("gapratio", text);
+  const fs::path out = scratch("gapratio");
+  std::map<long, int> state;
+  if (run_command(binary() + " run " + scene.string() + " -o " + out.string() + " -q", msg) != 0)
     return state;
+  const auto r = nlohmann::json::parse(read_file(out / "results.json"));
+  for (const auto& c : r["contacts"])
+    state[c["end1"].get<long>()] = c["state"][key].get<int>();
+  return state;
+}
+
+} // namespace
+
+// Issue 16 item 7: bonds could only be made by an absolute gap. A stage's `methods` entry may give
+// `gap_ratio` instead, a fraction of each contact's radii sum: of the two pairs above, bonded up
+// to 0.05, only the first.
+TEST(Cli, BondsCanBeMadeByAFractionOfTheRadiiSum) {
+  const std::string contacts = R"([{"between": "ball-ball", "model": "linearpbond",
+      "properties": {"kn": 1e6, "pb_kn": 1e12, "pb_ks": 1e12, "pb_ten": 1e8, "pb_coh": 1e8,
+                     "bond": false}}])";
+  auto bonded = [&](const std::string& gap, std::string* msg) {
+    return pair_states(contacts,
+                       R"([{"cycles": 1}, {"cycles": 1, "methods": [{"model": "linearpbond",
+                           "method": "bond", )" +
+                           gap + "}]}]",
+                       "pb_state", msg);
   };
   std::string msg;
   const auto by_ratio = bonded("\"gap_ratio\": 0.05", &msg);
@@ -375,64 +390,39 @@ TEST(Cli, BondsCanBeMadeByAFractionOfTheRadiiSum) {
 // (parallel bond, contact bond, smooth joint and flat joint alike; a flat joint's `true` bonds
 // every new contact, a range only the contacts whose creation gap lies in it).
 TEST(Cli, NewContactsCanBeBondedByAFractionOfTheRadiiSum) {
-  const std::string scene_text = R"({
-    "dimension": 3, "margin": 0.001,
-    "balls": [{"id": 1, "position": [0, 0, 0], "radius": 0.01, "density": 2650, "fix": "all"},
-              {"id": 2, "position": [0.0205, 0, 0], "radius": 0.01, "density": 2650, "fix": "all"},
-              {"id": 3, "position": [1, 0, 0], "radius": 0.001, "density": 2650, "fix": "all"},
-              {"id": 4, "position": [1.0025, 0, 0], "radius": 0.001, "density": 2650, "fix": "all"}],
-    "contact_models": [{"between": "ball-ball", "model": "MODEL", "properties": PROPS}],
-    "run": {"cycles": 1}
-  })";
-  // The contact state of each pair (by its first ball) in results.json.
-  auto states = [&](const std::string& model, const std::string& props, const char* key,
-                    std::string* msg) {
-    std::string text = scene_text;
-    text.replace(text.find("MODEL"), 5, model);
-    text.replace(text.find("PROPS"), 5, props);
-    const fs::path scene = write_scene("gapratio-create", text);
-    const fs::path out = scratch("gapratio-create");
-    std::map<long, int> state;
-    if (run_command(binary() + " run " + scene.string() + " -o " + out.string() + " -q", msg) != 0)
-      return state;
-    const auto r = nlohmann::json::parse(read_file(out / "results.json"));
-    for (const auto& c : r["contacts"])
-      state[c["end1"].get<long>()] = c["state"][key].get<int>();
-    return state;
+  auto states = [](const std::string& model, const std::string& props, const std::string& bond,
+                   const char* key, std::string* msg) {
+    return pair_states(R"([{"between": "ball-ball", "model": ")" + model + R"(", "properties": )" +
+                           props + R"(, "bond": )" + bond + "}}]",
+                       R"({"cycles": 1})", key, msg);
   };
   std::string msg;
-  const std::string pb = R"({"kn": 1e6, "pb_kn": 1e12, "pb_ks": 1e12, "pb_ten": 1e8, "pb_coh": 1e8,
-                             "bond": BOND})";
-  const std::string fj = R"({"fj_kn": 1e12, "fj_ks": 1e12, "fj_ten": 1e8, "fj_coh": 1e8,
-                             "bond": BOND})";
-  auto with = [](std::string props, const std::string& bond) {
-    props.replace(props.find("BOND"), 4, bond);
-    return props;
-  };
-  // Gaps: 5e-4 m = 0.025 of 0.02 m (pair 1), 5e-4 m = 0.25 of 0.002 m (pair 3).
-  auto pbs = states("linearpbond", with(pb, R"({"gap_ratio": [-1, 0.05]})"), "pb_state", &msg);
+  const std::string pb =
+      R"({"kn": 1e6, "pb_kn": 1e12, "pb_ks": 1e12, "pb_ten": 1e8, "pb_coh": 1e8)";
+  const std::string fj = R"({"fj_kn": 1e12, "fj_ks": 1e12, "fj_ten": 1e8, "fj_coh": 1e8)";
+  auto pbs = states("linearpbond", pb, R"({"gap_ratio": [-1, 0.05]})", "pb_state", &msg);
   ASSERT_EQ(pbs.size(), 2u) << msg;
   EXPECT_EQ(pbs.at(1), 3); // bonded
   EXPECT_EQ(pbs.at(3), 0); // not
-  pbs = states("linearpbond", with(pb, R"({"gap": [-1, 0.001]})"), "pb_state", &msg);
+  pbs = states("linearpbond", pb, R"({"gap": [-1, 0.001]})", "pb_state", &msg);
   ASSERT_EQ(pbs.size(), 2u) << msg;
   EXPECT_EQ(pbs.at(1), 3);
   EXPECT_EQ(pbs.at(3), 3);
-  auto fjs = states("flatjoint", with(fj, R"({"gap_ratio": [-1, 0.05]})"), "fj_mtype", &msg);
+  auto fjs = states("flatjoint", fj, R"({"gap_ratio": [-1, 0.05]})", "fj_mtype", &msg);
   ASSERT_EQ(fjs.size(), 2u) << msg;
   EXPECT_EQ(fjs.at(1), 1); // bonded
   EXPECT_EQ(fjs.at(3), 3); // slit
-  fjs = states("flatjoint", with(fj, "true"), "fj_mtype", &msg);
+  fjs = states("flatjoint", fj, "true", "fj_mtype", &msg);
   ASSERT_EQ(fjs.size(), 2u) << msg;
   EXPECT_EQ(fjs.at(1), 1);
   EXPECT_EQ(fjs.at(3), 1);
-  fjs = states("flatjoint", with(fj, "0.0001"), "fj_mtype", &msg); // at most 0.1 mm: neither
+  fjs = states("flatjoint", fj, "0.0001", "fj_mtype", &msg); // at most 0.1 mm: neither
   ASSERT_EQ(fjs.size(), 2u) << msg;
   EXPECT_EQ(fjs.at(1), 3);
   EXPECT_EQ(fjs.at(3), 3);
   // A ratio range beyond the radii sum, or reversed: input errors naming the key.
   for (const char* bad : {R"({"gap_ratio": [-1, 2]})", R"({"gap_ratio": [0.1, 0]})"}) {
-    EXPECT_TRUE(states("linearpbond", with(pb, bad), "pb_state", &msg).empty()) << bad;
+    EXPECT_TRUE(states("linearpbond", pb, bad, "pb_state", &msg).empty()) << bad;
     EXPECT_NE(msg.find("'contact_models[0].properties.bond'"), std::string::npos) << msg;
     EXPECT_NE(msg.find("within [-1, 1]"), std::string::npos) << msg;
   }
