@@ -299,6 +299,12 @@ TEST(CalibrationFile, BadFilesNameTheKeyAndWhatIsAllowed) {
   j = good_calibration();
   j["budgte"] = 3;
   EXPECT_NE(error_of(j).find("budgte"), std::string::npos) << error_of(j);
+  // A ratio with an empty side (found by the seed-4 fuzz: "/flatjoint.fj_ten" crashed).
+  for (const char* bad : {"/flatjoint.fj_ten", "flatjoint.fj_coh/", "/"}) {
+    j = good_calibration();
+    j["parameters"][bad] = {{"role", "strength"}, {"bounds", {0.1, 10}}};
+    EXPECT_NE(error_of(j).find("with no empty side"), std::string::npos) << bad << error_of(j);
+  }
   // A material path that is not a card is named with the calibration file's key.
   j = good_calibration();
   j["material"] = "/dev/zero";

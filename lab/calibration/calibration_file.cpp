@@ -101,9 +101,12 @@ CardParam read_param(const CalibrationFile& c, JsonObject& top, const std::strin
                       "]: low must be below high");
   o.finish();
   double start = std::nan("");
+  if (p.path.empty() || (slash != std::string::npos && p.over.empty()))
+    top.fail(key, "a parameter is \"section.key\" or a ratio \"section.key/section.key\" "
+                  "(e.g. \"flatjoint.fj_coh/flatjoint.fj_ten\"), with no empty side");
   for (const std::string& path : {p.path, p.over}) {
     if (path.empty())
-      continue;
+      continue; // not a ratio
     const nlohmann::json* v = card_value(c.material, path);
     if (!v || !std::isfinite(number_of(*v)))
       top.fail(key, "the card " + c.material_file + " has no number or {\"mean\", \"sd\"} at \"" +
