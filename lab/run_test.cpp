@@ -2,6 +2,7 @@
 
 #include "io/json_input.hpp"
 #include "io/output_dir.hpp"
+#include "io/progress.hpp"
 #include "io/results.hpp"
 #include "io/specimen.hpp"
 #include "lab/protocol_table.hpp"
@@ -33,13 +34,15 @@ SpecimenSource obtain_specimen(const Protocol& p, const std::atomic<bool>* inter
       named_by(p.file, "specimen.material", [&] { return load_material_card(p.material_file); });
   apply_overrides(card,
                   {{p.shape, p.file, "specimen.shape"}, {p.cut, p.file, "specimen.cut"}, p.seed});
+  ProgressLine line("genesis", progress);
   GenesisResult g = run_genesis(
       card,
       [&](const std::string& s) {
-        if (progress)
-          std::fprintf(stderr, "[rocklab genesis] %s\n", s.c_str());
+        if (line.due())
+          line.show(s);
       },
       interrupt);
+  line.finish();
   src.meta = specimen_meta(card, g.report);
   src.model = std::move(g.model);
   return src;
@@ -53,6 +56,25 @@ Snapshot frame_snapshot(const LoadingFrame& f) {
   for (const Crack& c : f.cracks().cracks())
     s.cracks.push_back({c.position, c.normal, c.size, c.mode, c.time, c.step});
   return s;
+}
+
+/// The test's state in one line: phase, axial strain and stress, peak, cracks. The fraction done
+/// is known with a strain limit (strain / limit) and after the peak (the drop toward the stop
+/// rule's post_peak_fraction); before the peak of a test without a limit there is no honest ETA.
+void show_progress(ProgressLine& line, const LoadingFrame& f) {
+  const LabSample& c = f.current();
+  const Protocol& p = f.protocol();
+  const double peak = f.peak().load;
+  double frac = -1;
+  if (p.strain_limit > 0)
+    frac = c.axial_strain / p.strain_limit;
+  if (peak > 0 && c.load < 0.99 * peak && p.post_peak_fraction < 1) // past the peak
+    frac = std::max(frac, (peak - c.load) / ((1 - p.post_peak_fraction) * peak));
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%s  strain %.3g%%  %.4g MPa (peak %.4g)  cracks %lld",
+                f.phase_name(), 100 * c.axial_strain, c.axial_stress / 1e6, f.peak().stress / 1e6,
+                static_cast<long long>(f.cracks().total()));
+  line.show(buf, frac);
 }
 
 /// A test in progress: the model, the frame around it, the ParaView series and the checkpoint.
@@ -162,9 +184,8 @@ void FrameRun::write_checkpoint() {
 }
 
 bool FrameRun::loop() {
-  using clock = std::chrono::steady_clock;
-  auto last_print = clock::now();
   LoadingFrame& f = *frame;
+  ProgressLine progress("test", o.progress);
   while (!f.done()) {
     f.advance();
     if (f.snapshot_due()) {
@@ -184,15 +205,8 @@ bool FrameRun::loop() {
         write_checkpoint();
       return false; // OUTDIR is left untouched (the staging folder goes away)
     }
-    if (o.progress && clock::now() - last_print > std::chrono::seconds(2)) {
-      last_print = clock::now();
-      const LabSample& c = f.current();
-      std::fprintf(stderr,
-                   "[rocklab test] %s: step %lld  axial strain %.4g  stress %.4g Pa  peak %.4g Pa"
-                   "  cracks %lld\n",
-                   f.phase_name(), static_cast<long long>(model->step()), c.axial_strain,
-                   c.axial_stress, f.peak().load, static_cast<long long>(f.cracks().total()));
-    }
+    if (model->step() % 64 == 0 && progress.due())
+      show_progress(progress, f);
   }
   return true;
 }

@@ -1,6 +1,7 @@
 // rocklab command-line interface. All quantities in input and output files are SI.
 #include "contact/model_json.hpp"
 #include "io/output_dir.hpp"
+#include "io/progress.hpp"
 #include "io/scene.hpp"
 #include "io/scene_run.hpp"
 #include "io/specimen.hpp"
@@ -19,7 +20,6 @@
 #include <filesystem>
 #include <functional>
 #include <iostream>
-#include <unistd.h>
 
 namespace {
 
@@ -33,7 +33,7 @@ int run_command(const std::string& scene_file, const std::string& out_dir, bool 
   rocklab::Scene scene = rocklab::load_scene(scene_file);
   rocklab::RunOptions opts;
   opts.out_dir = out_dir;
-  opts.progress = !quiet && ::isatty(STDERR_FILENO);
+  opts.progress = !quiet; // a line in place on a terminal, every ~10 s in a log
   opts.interrupt = &g_interrupt;
   const rocklab::RunSummary s = rocklab::run_scene(scene, opts);
   if (!quiet) {
@@ -80,14 +80,15 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
   if (seed >= 0)
     overrides.seed = static_cast<std::uint64_t>(seed);
   rocklab::apply_overrides(card, overrides);
-  const bool tty = !quiet && ::isatty(STDERR_FILENO);
+  rocklab::ProgressLine progress("genesis", !quiet);
   rocklab::GenesisResult g = rocklab::run_genesis(
       card,
       [&](const std::string& phase) {
-        if (tty)
-          std::fprintf(stderr, "[rocklab genesis] %s\n", phase.c_str());
+        if (progress.due())
+          progress.show(phase);
       },
       &g_interrupt);
+  progress.finish();
   if (g_interrupt.load())
     throw std::runtime_error("interrupted; no specimen was written");
   const nlohmann::json report = g.report.to_json();
@@ -139,7 +140,7 @@ int test_command(const std::string& protocol_file, const std::string& out_dir, b
   const std::unique_ptr<rocklab::LabProtocol> test = rocklab::lab_protocol_of(j, protocol_file);
   rocklab::LabOptions o;
   o.out_dir = out_dir;
-  o.progress = !quiet && ::isatty(STDERR_FILENO);
+  o.progress = !quiet;
   o.interrupt = &g_interrupt;
   o.checkpoint_every = checkpoint_every;
   o.resume_path = resume;
@@ -250,6 +251,7 @@ CLI::App* add_calibrate(CLI::App& app, CalibrateArgs& a, bool& quiet) {
       "calibrate", "Fit a material card's micro-parameters to laboratory targets "
                    "(docs/calibration.md); writes OUT/card.json, report.md, convergence.csv/svg "
                    "and keeps every evaluation in OUT/evaluations/ (a rerun reuses them)");
+  c->footer("Example: rocklab calibrate lab/calibrate/lac_du_bonnet_2d.json -o out/cal --check");
   c->add_option("calibration", a.file, "Calibration file (JSON)")->required();
   c->add_option("-o,--out", a.out, "Output directory")->required();
   c->add_option("--jobs", a.jobs,
@@ -336,6 +338,7 @@ int main(int argc, char** argv) {
   CLI::App* run = app.add_subcommand(
       "run", "Run a hand-built scene (docs/scene-format.md); writes OUT/results.json and "
              "OUT/history.csv");
+  run->footer("Example: rocklab run examples/ball_drop.json -o out/ball_drop");
   run->add_option("scene", scene_file, "Scene file (JSON)")->required();
   run->add_option("-o,--out", out_dir, "Output directory")->required();
   add_run_options(run, threads, quiet);
@@ -344,6 +347,7 @@ int main(int argc, char** argv) {
   CLI::App* gen = app.add_subcommand(
       "genesis", "Make a specimen from a material card (docs/material-format.md); writes "
                  "SPECIMEN and SPECIMEN.report.json");
+  gen->footer("Example: rocklab genesis materials/granite_fj_2d.json -o out/granite.rlspec");
   gen->add_option("material", material_file, "Material card (JSON)")->required();
   gen->add_option("-o,--out", specimen_out, "Specimen file to write")->required();
   add_run_options(gen, threads, quiet);
@@ -362,6 +366,7 @@ int main(int argc, char** argv) {
       "test",
       "Run a laboratory test (docs/protocol-format.md): UCS, triaxial, Brazilian, direct "
       "tension or drop (impact); writes OUT/results.json, history.csv, cracks.csv, vtk/ and plots");
+  test->footer("Example: rocklab test lab/ucs_granite.json -o out/ucs");
   test->add_option("protocol", protocol_file, "Protocol file (JSON)")->required();
   test->add_option("-o,--out", test_out, "Output directory")->required();
   test->add_option("--checkpoint-every", checkpoint_every,
@@ -375,6 +380,7 @@ int main(int argc, char** argv) {
       "suite", "Run a suite of laboratory tests on one material in parallel processes "
                "(docs/protocol-format.md); writes OUT/summary.json, summary.csv, tests.csv and "
                "OUT/tests/NAME/");
+  suite->footer("Example: rocklab suite lab/suites/granite_2d.json -o out/suite");
   suite->add_option("suite", suite_file, "Suite file (JSON)")->required();
   suite->add_option("-o,--out", suite_out, "Output directory")->required();
   add_run_options(suite, threads, quiet, "OpenMP threads per test process");

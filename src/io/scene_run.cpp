@@ -1,6 +1,7 @@
 #include "io/scene_run.hpp"
 
 #include "io/output_dir.hpp"
+#include "io/progress.hpp"
 #include "io/results.hpp"
 
 #include <chrono>
@@ -9,13 +10,38 @@
 
 namespace rocklab {
 
+namespace {
+
+// The state of a running stage: its step and time, and how far it is (cycles or time) or its
+// unbalanced-force ratio; the ETA only for a one-stage scene, where the fraction is the run's.
+void show_progress(ProgressLine& line, const Scene& scene, std::size_t stage, const Model& m,
+                   std::int64_t step0, double time0) {
+  const RunSpec& run = scene.stages[stage].run;
+  double frac = -1;
+  if (run.cycles > 0)
+    frac = static_cast<double>(m.step() - step0) / static_cast<double>(run.cycles);
+  else if (run.time > 0)
+    frac = (m.time() - time0) / run.time;
+  char buf[160];
+  const int n = std::snprintf(buf, sizeof buf, "stage %zu/%zu  step %lld  t %.4g s  ", stage + 1,
+                              scene.stages.size(), static_cast<long long>(m.step()), m.time());
+  if (frac >= 0)
+    std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "%.1f%%", 100.0 * frac);
+  else
+    std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n), "ratio %.3g",
+                  m.mean_unbalanced_force_ratio(true));
+  line.show(buf, scene.stages.size() == 1 ? frac : -1);
+}
+
+} // namespace
+
 RunSummary run_scene(Scene& scene, const RunOptions& opts) {
   using clock = std::chrono::steady_clock;
   OutputDir out(opts.out_dir);
   Model& m = *scene.model;
   RunSummary summary;
   const auto t0 = clock::now();
-  auto last_print = t0;
+  ProgressLine progress("run", opts.progress);
 
   m.initialize();
   std::vector<Event> events;
@@ -29,6 +55,7 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
     history += history_row(m, scene.history, summary.events);
   }
 
+  std::size_t stage_index = 0;
   for (const Stage& stage : scene.stages) {
     for (const BallChange& bc : stage.set) {
       if (bc.velocity)
@@ -65,30 +92,12 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
       summary.events.add(events);
       if (want_history && m.step() % scene.history_every == 0)
         history += history_row(m, scene.history, summary.events);
-      if (opts.progress) {
-        const auto now = clock::now();
-        if (now - t0 > std::chrono::seconds(2) &&
-            now - last_print > std::chrono::milliseconds(500)) {
-          last_print = now;
-          double frac = -1;
-          if (run.cycles > 0)
-            frac = static_cast<double>(m.step() - step0) / static_cast<double>(run.cycles);
-          else if (run.time > 0)
-            frac = (m.time() - time0) / run.time;
-          if (frac >= 0)
-            std::fprintf(stderr, "\r[rocklab] step %lld  t = %.4g s  %5.1f%%   ",
-                         static_cast<long long>(m.step()), m.time(), 100.0 * frac);
-          else
-            std::fprintf(stderr, "\r[rocklab] step %lld  t = %.4g s  ratio %.3g   ",
-                         static_cast<long long>(m.step()), m.time(),
-                         m.mean_unbalanced_force_ratio(true));
-          std::fflush(stderr);
-        }
-      }
+      if (m.step() % 64 == 0 && progress.due())
+        show_progress(progress, scene, stage_index, m, step0, time0);
     }
+    ++stage_index;
   }
-  if (opts.progress && clock::now() - t0 > std::chrono::seconds(2))
-    std::fprintf(stderr, "\n");
+  progress.finish();
   if (want_history && m.step() % scene.history_every != 0)
     history += history_row(m, scene.history, summary.events);
 
