@@ -54,7 +54,8 @@ void Model::move_clumps(double dt, std::array<double, 4>& sums) {
     Vec3 Lb = c.q.conjugate() * c.L;
     const Eigen::Quaterniond q0 = c.q;
     free_rotation(c.q, Lb, c.inertia, dt, dim);
-    const Eigen::Quaterniond turn = c.q * q0.conjugate(); // this step's rotation, global frame
+    // This step's rotation in the global frame, for the pebbles' orientations (tracking only).
+    const Eigen::Quaterniond turn = track ? c.q * q0.conjugate() : Eigen::Quaterniond::Identity();
     c.spin = c.q * Lb.cwiseQuotient(c.inertia);
     const Vec3 wm = 0.5 * (w0 + c.spin);
     dw -= Md.dot(wm) * dt;
