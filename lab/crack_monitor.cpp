@@ -1,6 +1,9 @@
 #include "lab/crack_monitor.hpp"
 
+#include "contact/registry.hpp"
 #include "io/results.hpp"
+
+#include <algorithm>
 
 namespace rocklab {
 
@@ -20,6 +23,13 @@ void CrackMonitor::consume(const Model& m, const std::vector<Event>& events) {
     c.gap = e.gap;
     c.strength = e.strength;
     c.energy = e.energy;
+    // the bond's parts (flat-joint elements): contacts are sorted by key
+    const auto& cs = m.contacts();
+    const auto it = std::lower_bound(cs.begin(), cs.end(), e.contact,
+                                     [](const Contact& a, std::uint64_t k) { return a.key < k; });
+    c.parts = std::max(1, e.element);
+    if (it != cs.end() && it->key == e.contact)
+      c.parts = std::max(c.parts, contact_bond_view(m.batches(), it->model, it->slot).parts);
     const ContactEnds ends = contact_ends(e.contact);
     c.ball1 = m.balls.id[static_cast<std::size_t>(ends.end1)];
     c.ball2 =
@@ -30,8 +40,9 @@ void CrackMonitor::consume(const Model& m, const std::vector<Event>& events) {
 }
 
 std::string CrackMonitor::csv() const {
-  std::string s = "time_s,step,x_m,y_m,z_m,nx,ny,nz,size_m,mode,ball1,ball2,contact,element,gap_m,"
-                  "strength_Pa,energy_J\n";
+  std::string s =
+      "time_s,step,x_m,y_m,z_m,nx,ny,nz,size_m,mode,ball1,ball2,contact,element,parts,gap_m,"
+      "strength_Pa,energy_J\n";
   auto field = [&s](const std::string& v) {
     s += v;
     s += ',';
@@ -49,6 +60,7 @@ std::string CrackMonitor::csv() const {
     field(std::to_string(c.ball2));
     field(std::to_string(c.contact));
     field(std::to_string(c.element));
+    field(std::to_string(c.parts));
     field(format_double(c.gap));
     field(format_double(c.strength));
     s += format_double(c.energy);
@@ -72,7 +84,8 @@ nlohmann::json CrackMonitor::to_json() const {
                  c.element,
                  c.gap,
                  c.strength,
-                 c.energy});
+                 c.energy,
+                 c.parts});
   return a;
 }
 
@@ -96,6 +109,7 @@ void CrackMonitor::from_json(const nlohmann::json& a) {
     c.gap = r[10].get<double>();
     c.strength = r[11].get<double>();
     c.energy = r[12].get<double>();
+    c.parts = r.size() > 13 ? r[13].get<int>() : 1;
     (c.mode == 1 ? tension_ : shear_) += 1;
     cracks_.push_back(c);
   }

@@ -21,6 +21,7 @@ struct Crack {
   std::int64_t ball1 = 0, ball2 = 0; ///< ids of the two grains
   std::uint64_t contact = 0;         ///< contact key
   int element = -1;                  ///< flat-joint element (1..N), -1 for a whole bond
+  int parts = 1;                     ///< bondable parts of its contact (flat-joint elements)
   double gap = 0;                    ///< contact gap at the break [m]
   double strength = 0;               ///< the strength that was exceeded [Pa]
   double energy = 0;                 ///< strain energy released by the break [J]

@@ -51,8 +51,10 @@ struct Protocol {
   bool vtk = true;                  ///< write ParaView files
   bool plots = true;                ///< write the SVG stress-strain plot and crack map
   bool orientation = false;         ///< track grain rotation from the loading on (ParaView)
-  nlohmann::json raw;               ///< the file as read
-  std::string text_hash;            ///< hash of the file's text
+  double event_window =
+      0;                 ///< fracture events: crack time window [s]; 0: 5 grain diameters / P wave
+  nlohmann::json raw;    ///< the file as read
+  std::string text_hash; ///< hash of the file's text
 };
 
 /// Read and validate a protocol file of a test in the loading frame; errors name the file, key,

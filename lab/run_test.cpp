@@ -5,10 +5,12 @@
 #include "io/progress.hpp"
 #include "io/results.hpp"
 #include "io/specimen.hpp"
+#include "lab/frame_snapshot.hpp"
 #include "lab/protocol_table.hpp"
 #include "lab/protocols/frame_test.hpp"
 #include "materials/genesis.hpp"
 #include "viz/svg_plots.hpp"
+#include "viz/svg_png.hpp"
 #include "viz/vtk_output.hpp"
 
 #include <omp.h>
@@ -17,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <numbers>
 
 namespace rocklab {
 
@@ -49,14 +52,6 @@ SpecimenSource obtain_specimen(const Protocol& p, const std::atomic<bool>* inter
 }
 
 namespace {
-
-/// What the frame shows at one moment, with every crack so far.
-Snapshot frame_snapshot(const LoadingFrame& f) {
-  Snapshot s = take_snapshot(f.model(), f.reference_positions(), f.current().axial_strain);
-  for (const Crack& c : f.cracks().cracks())
-    s.cracks.push_back({c.position, c.normal, c.size, c.mode, c.time, c.step});
-  return s;
-}
 
 /// The test's state in one line: phase, axial strain and stress, peak, cracks. The fraction done
 /// is known with a strain limit (strain / limit) and after the peak (the drop toward the stop
@@ -243,7 +238,8 @@ std::vector<PlotMarker> crack_markers(const LoadingFrame& f, const nlohmann::jso
 
 // Stress-strain plot with crack counts; crack map of the final state.
 void write_plots(const FrameTest& test, const LoadingFrame& f, const nlohmann::json& meta,
-                 const nlohmann::json& r, OutputDir& out, std::vector<std::string>& files) {
+                 const nlohmann::json& r, const EventClustering& ev, OutputDir& out,
+                 std::vector<std::string>& files) {
   const PlotLabels labels = test.plot_labels();
   PlotSeries axial{"axial stress vs axial strain", {}, {}, "#000000"};
   PlotSeries lateral{"axial stress vs lateral strain", {}, {}, "#7f7f7f", true};
@@ -277,11 +273,15 @@ void write_plots(const FrameTest& test, const LoadingFrame& f, const nlohmann::j
   series.push_back(cs);
   const std::string title =
       std::string(test.name()) + " test: " + meta.value("material_name", std::string("specimen"));
-  write_text_file(out.staged("stress_strain.svg"),
-                  line_plot_svg(title, labels.x, labels.y, "cracks", series, crack_markers(f, r)));
-  write_text_file(out.staged("crack_map.svg"),
-                  crack_map_svg(frame_snapshot(f), title + ", cracks at the end", labels.map_axis));
-  files.insert(files.end(), {"stress_strain.svg", "crack_map.svg"});
+  Snapshot final = frame_snapshot(f);
+  add_fractures(final, f.cracks().cracks(), ev, INFINITY);
+  for (const auto& [svg, png] :
+       {write_svg_and_png(
+            out.staged("stress_strain.svg"),
+            line_plot_svg(title, labels.x, labels.y, "cracks", series, crack_markers(f, r))),
+        write_svg_and_png(out.staged("crack_map.svg"),
+                          crack_map_svg(final, title + ", cracks at the end", labels.map_axis))})
+    files.insert(files.end(), {svg, png});
 }
 
 void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::time_point t0) {
@@ -292,11 +292,28 @@ void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::t
     if (have_peak_snap)
       vtk->write(peak_snap, "peak");
     vtk->write(frame_snapshot(f));
+  }
+  nlohmann::json r = f.results();
+  const EventClustering ev = fracture_events(f, p, r);
+  if (p.vtk) {
+    const CellSummary cells = vtk->write_fractures([&](double t) {
+      Snapshot s;
+      s.dim = f.model().settings.dim;
+      s.outline.round = f.geometry().round || f.geometry().diametral;
+      add_fractures(s, f.cracks().cracks(), ev, t);
+      return s;
+    });
+    r["power_cells"] = {{"grains", cells.grains},
+                        {"hidden_grains", cells.hidden},
+                        {"volume_sum_m3", cells.volume_sum},
+                        {"clip_shape_volume_m3", cells.shape_volume},
+                        {"specimen_volume_m3", f.current_volume()},
+                        {"contact_cracks", cells.contact_cracks},
+                        {"contact_cracks_as_faces", cells.faced_cracks}};
     for (const std::string& name : vtk->write_collections())
       sum.files.push_back("vtk/" + name);
   }
   sum.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  nlohmann::json r = f.results();
   r["protocol"] = p.file;
   r["provenance"] = {{"rocklab_version", ROCKLAB_VERSION},
                      {"test_revision", test.revision()},
@@ -313,9 +330,10 @@ void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::t
                      {"wall_time_s", sum.wall_seconds}};
   write_text_file(out.staged("history.csv"), f.history_csv());
   write_text_file(out.staged("cracks.csv"), f.cracks().csv());
-  sum.files.insert(sum.files.end(), {"results.json", "history.csv", "cracks.csv"});
+  write_text_file(out.staged("events.csv"), events_csv(ev.events));
+  sum.files.insert(sum.files.end(), {"results.json", "history.csv", "cracks.csv", "events.csv"});
   if (p.plots)
-    write_plots(test, f, meta, r, out, sum.files);
+    write_plots(test, f, meta, r, ev, out, sum.files);
   r["files"] = sum.files;
   sum.results = r;
   write_text_file(out.staged("results.json"), r.dump(2) + "\n");

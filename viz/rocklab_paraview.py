@@ -1,62 +1,280 @@
-"""ParaView set-up for a rocklab test folder (all quantities SI: m, s, Pa).
+"""ParaView set-up for a rocklab test folder. All quantities SI: m, s, Pa.
 
-Run inside ParaView (View > Python Shell > Run Script, or `pvpython`/`paraview --script=`):
+    pvpython viz/rocklab_paraview.py OUTDIR                      # interactive view
+    pvbatch  viz/rocklab_paraview.py OUTDIR --png crack.png      # headless picture of the end
+    pvbatch  viz/rocklab_paraview.py OUTDIR --frames DIR         # one PNG per snapshot
+    (inside ParaView: View > Python Shell > Run Script, with ROCKLAB_OUT=OUTDIR)
 
-    pvpython viz/rocklab_paraview.py OUTDIR          # or set OUTDIR below / ROCKLAB_OUT
+Options: --at end|peak|N (the snapshot shown; default end), --color time|mode|event|damage
+(what colours the cracks; default time of formation), --grains (draw the grains as spheres or
+disks instead of their faced cells), --walls (show the platens), --size WxH (pixels).
 
-It opens OUTDIR/vtk/{grains,bonds,cracks,walls}.pvd, draws grains as spheres (3D) or disks (2D)
-scaled by their radius and coloured by displacement magnitude, bonds as lines coloured by
-broken-element fraction, cracks coloured by mode (1 tension = red, 2 shear = blue) and the
-platens as a translucent surface, then jumps to the last time step.
+What it draws (rocklab test writes the series, viz/README.md):
+- the grains' power cells (cells.pvd): 3D the specimen's skin, faded, so the fracture inside
+  shows through; 2D every cell, coloured by its grain's von Mises stress [Pa] with the range over
+  the whole series;
+- one crack per broken contact (contact_cracks.pvd), each the face its two grains' cells share,
+  so broken contacts join into fracture surfaces, coloured by the time they formed [s] (or mode:
+  tension orange, shear blue; event; damage) in a palette distinct from the grains';
+- legends with units and a caption with the test, material, axial strain and stress of the frame.
+The camera frames the specimen (not the platens, which are metres wide).
 """
+import json
 import os
 import sys
 
-from paraview.simple import (  # noqa: F401  (ParaView's own module)
-    ColorBy, GetActiveViewOrCreate, GetAnimationScene, GetColorTransferFunction, Glyph,
-    Hide, PVDReader, Render, ResetCamera, Show)
+from paraview import servermanager  # noqa: F401  (ParaView's own modules)
+from paraview.simple import (
+    ColorBy, GetActiveViewOrCreate, GetAnimationScene, GetColorTransferFunction,
+    GetOpacityTransferFunction, GetScalarBar,
+    Glyph, Hide, PVDReader, Render, SaveScreenshot, Show, Text, Threshold)
 
-out = os.environ.get("ROCKLAB_OUT") or (sys.argv[1] if len(sys.argv) > 1 else ".")
-vtk_dir = os.path.join(out, "vtk")
-if not os.path.isdir(vtk_dir):
-    raise SystemExit("no %s: give the output folder of `rocklab test`" % vtk_dir)
 
-view = GetActiveViewOrCreate("RenderView")
+def parse(argv):
+    opts = {"out": os.environ.get("ROCKLAB_OUT", "."), "png": None, "frames": None, "at": "end",
+            "color": "time", "grains": False, "walls": False, "size": (1600, 1200)}
+    args = list(argv)
+    positional = []
+    while args:
+        a = args.pop(0)
+        if a in ("--png", "--frames", "--at", "--color", "--size"):
+            if not args:
+                raise SystemExit("%s needs a value" % a)
+            v = args.pop(0)
+            if a == "--size":
+                w, h = v.lower().split("x")
+                opts["size"] = (int(w), int(h))
+            else:
+                opts[a[2:]] = v
+        elif a in ("--grains", "--walls"):
+            opts[a[2:]] = True
+        elif a.startswith("--"):
+            raise SystemExit("unknown option %s (see the top of %s)" % (a, __file__))
+        else:
+            positional.append(a)
+    if positional:
+        opts["out"] = positional[0]
+    if opts["color"] not in ("time", "mode", "event", "damage"):
+        raise SystemExit("--color must be time, mode, event or damage, not %s" % opts["color"])
+    return opts
 
-grains = PVDReader(FileName=os.path.join(vtk_dir, "grains.pvd"))
-glyph = Glyph(Input=grains, GlyphType="Sphere")
-glyph.ScaleArray = ["POINTS", "radius"]
-glyph.ScaleFactor = 2.0  # the sphere source has unit diameter: scale by 2 R
-glyph.GlyphMode = "All Points"
-glyph.GlyphType.ThetaResolution = 16
-glyph.GlyphType.PhiResolution = 12
-gd = Show(glyph, view)
-ColorBy(gd, ("POINTS", "displacement", "Magnitude"))
-gd.RescaleTransferFunctionToDataRange(True)
-gd.Opacity = 0.35
-Hide(grains, view)
 
-bonds = PVDReader(FileName=os.path.join(vtk_dir, "bonds.pvd"))
-bd = Show(bonds, view)
-ColorBy(bd, ("CELLS", "broken_fraction"))
-bd.LineWidth = 1.5
-Hide(bonds, view)  # switch on in the pipeline browser
+def series_range(source, association, array, times):
+    """The range of an array over every time step of a series (not just the first)."""
+    lo, hi = float("inf"), float("-inf")
+    for t in times or [None]:
+        if t is None:
+            source.UpdatePipeline()
+        else:
+            source.UpdatePipeline(t)
+        info = source.GetCellDataInformation() if association == "CELLS" else \
+            source.GetPointDataInformation()
+        a = info.GetArray(array)
+        if a is None:
+            continue
+        r = a.GetRange(-1 if a.GetNumberOfComponents() > 1 else 0)
+        lo, hi = min(lo, r[0]), max(hi, r[1])
+    if lo > hi:
+        return 0.0, 1.0
+    return (lo, hi) if hi > lo else (lo, lo + 1.0)
 
-cracks = PVDReader(FileName=os.path.join(vtk_dir, "cracks.pvd"))
-cd = Show(cracks, view)
-ColorBy(cd, ("CELLS", "mode"))
-lut = GetColorTransferFunction("mode")
-lut.InterpretValuesAsCategories = 1
-lut.Annotations = ["1", "tension", "2", "shear"]
-lut.IndexedColors = [0.84, 0.15, 0.16, 0.12, 0.25, 0.75]
-cd.LineWidth = 3.0
 
-walls = PVDReader(FileName=os.path.join(vtk_dir, "walls.pvd"))
-wd = Show(walls, view)
-wd.Opacity = 0.2
+def frame_fields(source, t):
+    """step, axial strain and stress of the frame at time t (the files' field data)."""
+    source.UpdatePipeline(t)
+    data = servermanager.Fetch(source)
+    out = {}
+    fd = data.GetFieldData() if data is not None else None
+    for name in ("step", "axial_strain", "axial_stress", "time"):
+        arr = fd.GetArray(name) if fd is not None else None
+        if arr is not None and arr.GetNumberOfTuples() > 0:
+            out[name] = arr.GetValue(0)
+    return out
 
-scene = GetAnimationScene()
-scene.UpdateAnimationUsingDataTimeSteps()
-scene.AnimationTime = scene.EndTime
-ResetCamera(view)
-Render(view)
+
+def legend(view, lut, title, position):
+    bar = GetScalarBar(lut, view)
+    bar.Title = title
+    bar.ComponentTitle = ""
+    bar.Visibility = 1
+    bar.WindowLocation = "Any Location"
+    bar.Position = position
+    bar.ScalarBarLength = 0.33
+    bar.TitleColor = bar.LabelColor = [0.1, 0.1, 0.1]
+    bar.TitleFontSize = bar.LabelFontSize = 16
+    return bar
+
+
+def main(argv):
+    o = parse(argv)
+    vtk_dir = os.path.join(o["out"], "vtk")
+    if not os.path.isfile(os.path.join(vtk_dir, "grains.pvd")):
+        raise SystemExit("no %s/grains.pvd: give the output folder of `rocklab test`" % vtk_dir)
+    results = {}
+    if os.path.isfile(os.path.join(o["out"], "results.json")):
+        with open(os.path.join(o["out"], "results.json")) as f:
+            results = json.load(f)
+    dim = results.get("specimen", {}).get("dimension", 3)
+
+    view = GetActiveViewOrCreate("RenderView")
+    view.ViewSize = list(o["size"])
+    view.Background = [1, 1, 1]
+    try:  # ParaView >= 5.10 keeps the background in the view's own palette unless told
+        view.UseColorPaletteForBackground = 0
+    except AttributeError:
+        pass
+    view.OrientationAxesVisibility = 0  # the loading axis is vertical; the caption says so
+
+    def reader(name):
+        path = os.path.join(vtk_dir, name + ".pvd")
+        return PVDReader(FileName=path) if os.path.isfile(path) else None
+
+    grains, cells, cracks = reader("grains"), reader("cells"), reader("contact_cracks")
+    if cracks is None:  # an older output: every crack record
+        cracks = reader("cracks")
+    times = list(grains.TimestepValues) if grains.TimestepValues else []
+    scene = GetAnimationScene()
+    scene.UpdateAnimationUsingDataTimeSteps()
+
+    # Grains: faced cells (3D: the skin, faded) or spheres/disks.
+    if cells is not None and not o["grains"]:
+        if dim == 3:
+            skin = Threshold(Input=cells)
+            skin.Scalars = ["CELLS", "boundary"]
+            try:
+                skin.LowerThreshold, skin.UpperThreshold = 0.5, 1.5
+            except AttributeError:  # ParaView < 5.10
+                skin.ThresholdRange = [0.5, 1.5]
+            gd = Show(skin, view)
+            gd.ColorArrayName = ["POINTS", ""]
+            gd.AmbientColor = gd.DiffuseColor = [0.62, 0.62, 0.62]
+            gd.Opacity = 0.12
+        else:
+            gd = Show(cells, view)
+            ColorBy(gd, ("CELLS", "von_mises_stress"))
+            glut = GetColorTransferFunction("von_mises_stress")
+            glut.ApplyPreset("Grayscale", True)
+            glut.InvertTransferFunction()
+            glut.RescaleTransferFunction(*series_range(cells, "CELLS", "von_mises_stress", times))
+            legend(view, glut, "grain von Mises stress [Pa]", [0.86, 0.08])
+            gd.SetRepresentationType("Surface With Edges")
+            gd.EdgeColor = [0.55, 0.55, 0.55]
+    else:
+        glyph = Glyph(Input=grains, GlyphType="Sphere")
+        glyph.ScaleArray = ["POINTS", "radius"]
+        glyph.ScaleFactor = 2.0  # the unit-diameter sphere scaled to 2 R
+        glyph.GlyphMode = "All Points"
+        gd = Show(glyph, view)
+        ColorBy(gd, ("POINTS", "displacement", "Magnitude"))
+        glut = GetColorTransferFunction("displacement")
+        glut.ApplyPreset("Grayscale", True)
+        glut.RescaleTransferFunction(*series_range(grains, "POINTS", "displacement", times))
+        legend(view, glut, "grain displacement [m]", [0.86, 0.08])
+        gd.Opacity = 0.25 if dim == 3 else 1.0
+    Hide(grains, view)
+
+    # Cracks, one per broken contact, in a palette the grains do not use.
+    if cracks is not None:
+        cd = Show(cracks, view)
+        field = o["color"] if o["color"] != "damage" else "damage"
+        ColorBy(cd, ("CELLS", field))
+        lut = GetColorTransferFunction(field)
+        if field == "mode":
+            lut.InterpretValuesAsCategories = 1
+            lut.Annotations = ["1", "tension", "2", "shear"]
+            lut.IndexedColors = [0.93, 0.45, 0.0, 0.12, 0.3, 0.85]
+            title = "crack mode"
+        else:
+            lut.ApplyPreset("Inferno (matplotlib)" if field == "time" else "Viridis (matplotlib)",
+                            True)
+            lut.RescaleTransferFunction(*series_range(cracks, "CELLS", field, times))
+            title = {"time": "crack formed at time [s]", "event": "fracture event [-]",
+                     "damage": "contact damage: broken / bonded parts [-]"}[field]
+        legend(view, lut, title, [0.03, 0.08])
+        cd.LineWidth = 3.0
+        cd.Opacity = 1.0
+        if times:
+            cracks.UpdatePipeline(times[-1])
+        many = cracks.GetDataInformation().GetNumberOfCells() > 400
+        if field == "time" and dim == 3 and many:
+            # Too many to see through: the early, scattered microcracks faded, the late ones (the
+            # macro-fracture that forms through and after the peak) opaque - the opacity grows
+            # with the time of formation.
+            t0, t1 = series_range(cracks, "CELLS", "time", times)
+            tp = results.get("peak_time_s", 0.5 * (t0 + t1))
+            tp = min(max(tp, t0), t1)
+            if tp >= t1:  # no post-peak part: the last fifth of the cracks' time span
+                tp = t0 + 0.8 * (t1 - t0)
+            pwf = GetOpacityTransferFunction("time")
+            pwf.Points = [t0, 0.08, 0.5, 0.0, tp, 0.3, 0.5, 0.0, t1, 1.0, 0.5, 0.0]
+            lut.EnableOpacityMapping = 1
+            try:
+                view.UseDepthPeeling = 1
+            except AttributeError:
+                pass
+
+    if o["walls"]:
+        walls = reader("walls")
+        if walls is not None:
+            Show(walls, view).Opacity = 0.15
+
+    caption = Text()
+    cap = Show(caption, view)
+    cap.WindowLocation = "Upper Left Corner"
+    cap.FontSize = 18
+    cap.Color = [0.1, 0.1, 0.1]
+
+    def show_frame(t):
+        scene.AnimationTime = t
+        f = frame_fields(cells or grains, t)
+        name = results.get("test", "test")
+        material = results.get("provenance", {}).get("material", "")
+        caption.Text = ("%s test  %s  (loading axis vertical)\n"
+                        "axial strain %.3f %%   axial stress %.1f MPa   step %d") % (
+            name.upper(), material, 100 * f.get("axial_strain", 0.0),
+            1e-6 * f.get("axial_stress", 0.0), int(f.get("step", 0)))
+        frame_specimen(view, cells or grains, t, dim)
+        Render(view)
+
+    if o["frames"]:
+        os.makedirs(o["frames"], exist_ok=True)
+        for i, t in enumerate(times):
+            show_frame(t)
+            SaveScreenshot(os.path.join(o["frames"], "frame_%04d.png" % i), view,
+                           ImageResolution=list(o["size"]))
+    at = times[-1] if times else 0.0
+    if o["at"] == "peak":
+        peak = results.get("peak_time_s")
+        at = min(times, key=lambda t: abs(t - peak)) if peak is not None and times else at
+    elif o["at"] not in ("end", "peak"):
+        at = times[int(o["at"])]
+    show_frame(at)
+    if o["png"]:
+        SaveScreenshot(o["png"], view, ImageResolution=list(o["size"]))
+        print("wrote %s" % o["png"])
+
+
+def frame_specimen(view, source, t, dim):
+    """Point the camera at the specimen's bounds (2D: straight down z, parallel projection)."""
+    source.UpdatePipeline(t)
+    b = source.GetDataInformation().GetBounds()
+    cx, cy, cz = 0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])
+    span = max(b[1] - b[0], b[3] - b[2], b[5] - b[4])
+    cam = view.GetActiveCamera()
+    view.CameraFocalPoint = [cx, cy, cz]
+    if dim == 2:
+        view.CameraPosition = [cx, cy, cz + 4 * span]
+        view.CameraViewUp = [0, 1, 0]
+        view.CameraParallelProjection = 1
+        view.CameraParallelScale = 0.58 * max(b[1] - b[0], b[3] - b[2])
+    else:  # an oblique view from the side, z (the loading axis) up
+        view.CameraPosition = [cx + 2.2 * span, cy - 1.6 * span, cz + 0.5 * span]
+        view.CameraViewUp = [0, 0, 1]
+        view.CameraParallelProjection = 0
+        cam.SetViewAngle(30)
+        view.ResetCamera(b[0], b[1], b[2], b[3], b[4], b[5])
+        cam.Zoom(1.25)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -42,15 +42,29 @@ double tick_step(double span) {
   return 10 * mag;
 }
 
-std::string tick_label(double v, double step) {
-  char b[32];
-  const int digits = std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
-  std::snprintf(b, sizeof b, "%.*f", std::min(digits, 6), std::abs(v) < 1e-12 * step ? 0.0 : v);
-  return b;
+// The decimals that print every multiple of `step` exactly (0.25 needs 2, 0.5 needs 1, 20 none).
+int tick_digits(double step) {
+  for (int d = 0; d < 9; ++d) {
+    const double scaled = step * std::pow(10.0, d);
+    if (std::abs(scaled - std::round(scaled)) < 1e-6 * scaled)
+      return d;
+  }
+  return 9;
 }
 
+std::string tick_label(double v, int digits) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.*f", digits, v);
+  std::string t = b;
+  if (t.find_first_not_of("-0.") == std::string::npos)
+    t = t.substr(t[0] == '-' ? 1 : 0); // no "-0.00"
+  return t;
+}
+
+// An axis: its limits are whole multiples of its tick step, and its ticks are the multiples k *
+// step between them (computed from k, so no drift and no tick off the grid).
 struct Range1 {
-  double lo = 1e300, hi = -1e300;
+  double lo = 1e300, hi = -1e300, step = 1;
   void add(double v) {
     if (std::isfinite(v)) {
       lo = std::min(lo, v);
@@ -62,11 +76,140 @@ struct Range1 {
       lo = 0, hi = 1;
     if (hi - lo <= 0)
       hi = lo + 1;
-    const double st = tick_step(hi - lo);
-    lo = std::floor(lo / st) * st;
-    hi = std::ceil(hi / st) * st;
+    step = tick_step(hi - lo);
+    lo = std::floor(lo / step + 1e-9) * step;
+    hi = std::ceil(hi / step - 1e-9) * step;
+  }
+  /// (value, label) of every tick
+  std::vector<std::pair<double, std::string>> ticks() const {
+    std::vector<std::pair<double, std::string>> t;
+    const long k0 = std::lround(lo / step), k1 = std::lround(hi / step);
+    const int digits = tick_digits(step);
+    for (long k = k0; k <= k1; ++k)
+      t.emplace_back(static_cast<double>(k) * step,
+                     tick_label(static_cast<double>(k) * step, digits));
+    return t;
   }
 };
+
+} // namespace
+
+namespace {
+
+// Where a line plot draws: the plot area [L, L + pw] x [T, T + ph] and the axes' mappings.
+struct PlotFrame {
+  double W = 760, H = 480, L = 80, R = 30, T = 50, B = 60;
+  Range1 rx, ry, ry2;
+  double pw() const { return W - L - R; }
+  double ph() const { return H - T - B; }
+  double X(double v) const { return L + (v - rx.lo) / (rx.hi - rx.lo) * pw(); }
+  double Y(double v, bool right) const {
+    const Range1& r = right ? ry2 : ry;
+    return T + ph() - (v - r.lo) / (r.hi - r.lo) * ph();
+  }
+};
+
+struct LegendBox {
+  double x = 0, y = 0, w = 0, h = 0;
+  bool above = false; ///< in a band above the plot area (no free corner inside it)
+};
+
+// Whether the segment (x0, y0)-(x1, y1) meets the box (Liang-Barsky clipping).
+bool segment_meets_box(double x0, double y0, double x1, double y1, const LegendBox& b) {
+  double t0 = 0, t1 = 1;
+  const double dx = x1 - x0, dy = y1 - y0;
+  const double p[4] = {-dx, dx, -dy, dy};
+  const double q[4] = {x0 - (b.x - 4), b.x + b.w + 4 - x0, y0 - (b.y - 4), b.y + b.h + 4 - y0};
+  for (int i = 0; i < 4; ++i) {
+    if (p[i] == 0) {
+      if (q[i] < 0)
+        return false;
+      continue;
+    }
+    const double t = q[i] / p[i];
+    if (p[i] < 0)
+      t0 = std::max(t0, t);
+    else
+      t1 = std::min(t1, t);
+    if (t0 > t1)
+      return false;
+  }
+  return true;
+}
+
+// How many drawn segments, points and marker labels meet a box.
+std::size_t points_inside(const PlotFrame& f, const std::vector<PlotSeries>& series,
+                          const std::vector<PlotMarker>& markers, const LegendBox& b) {
+  std::size_t n = 0;
+  for (const PlotSeries& p : series) {
+    double px = NAN, py = NAN;
+    for (std::size_t i = 0; i < p.x.size() && i < p.y.size(); ++i) {
+      if (!std::isfinite(p.x[i]) || !std::isfinite(p.y[i]))
+        continue;
+      const double x = f.X(p.x[i]), y = f.Y(p.y[i], p.right_axis);
+      n += segment_meets_box(std::isfinite(px) ? px : x, std::isfinite(py) ? py : y, x, y, b);
+      px = x, py = y;
+    }
+  }
+  for (const PlotMarker& m : markers) {
+    const double x = f.X(m.x), y = f.Y(m.y, false);
+    const double w = 10 + 7.0 * static_cast<double>(m.label.size()); // the circle and its label
+    const bool right = x > f.L + 0.85 * f.pw();
+    const double mx0 = right ? x - w : x - 4, mx1 = right ? x + 4 : x + w;
+    n += mx0 < b.x + b.w + 4 && mx1 > b.x - 4 && y - 18 < b.y + b.h + 4 && y + 4 > b.y - 4;
+  }
+  return n;
+}
+
+// The legend goes into the corner of the plot area with no data; when every corner has data, into
+// a band above the plot area.
+LegendBox place_legend(PlotFrame& f, const std::vector<PlotSeries>& series,
+                       const std::vector<PlotMarker>& markers) {
+  std::size_t chars = 0;
+  for (const PlotSeries& p : series)
+    chars = std::max(chars, p.label.size());
+  LegendBox b;
+  b.w = 44 + 7.0 * static_cast<double>(chars), b.h = 16.0 * static_cast<double>(series.size());
+  if (series.empty())
+    return b;
+  for (int corner = 0; corner < 4; ++corner) {
+    b.x = corner % 2 == 0 ? f.L + 8 : f.L + f.pw() - 8 - b.w;
+    b.y = corner < 2 ? f.T + 6 : f.T + f.ph() - 6 - b.h;
+    if (points_inside(f, series, markers, b) == 0)
+      return b;
+  }
+  b.above = true, b.x = f.L + 8, b.y = f.T;
+  f.T += b.h + 6; // the picture grows; the plot area keeps its size
+  f.H += b.h + 6;
+  return b;
+}
+
+std::string axes_svg(const PlotFrame& f, bool has2) {
+  std::string s;
+  for (const auto& [v, label] : f.rx.ticks()) {
+    s += "<line x1=\"" + num(f.X(v)) + "\" y1=\"" + num(f.T) + "\" x2=\"" + num(f.X(v)) +
+         "\" y2=\"" + num(f.T + f.ph()) + "\" stroke=\"#e0e0e0\"/>\n";
+    s += "<text class=\"xtick\" x=\"" + num(f.X(v)) + "\" y=\"" + num(f.T + f.ph() + 16) +
+         "\" text-anchor=\"middle\">" + label + "</text>\n";
+  }
+  for (const auto& [v, label] : f.ry.ticks()) {
+    s += "<line x1=\"" + num(f.L) + "\" y1=\"" + num(f.Y(v, false)) + "\" x2=\"" +
+         num(f.L + f.pw()) + "\" y2=\"" + num(f.Y(v, false)) + "\" stroke=\"#e0e0e0\"/>\n";
+    s += "<text class=\"ytick\" x=\"" + num(f.L - 6) + "\" y=\"" + num(f.Y(v, false) + 4) +
+         "\" text-anchor=\"end\">" + label + "</text>\n";
+  }
+  if (has2)
+    for (const auto& [v, label] : f.ry2.ticks())
+      s += "<text class=\"y2tick\" x=\"" + num(f.L + f.pw() + 6) + "\" y=\"" +
+           num(f.Y(v, true) + 4) + "\">" + label + "</text>\n";
+  s += "<rect x=\"" + num(f.L) + "\" y=\"" + num(f.T) + "\" width=\"" + num(f.pw()) +
+       "\" height=\"" + num(f.ph()) + "\" fill=\"none\" stroke=\"black\"/>\n";
+  return s;
+}
+
+std::string dash(const PlotSeries& p) {
+  return p.dashed ? " stroke-dasharray=\"6,4\"" : "";
+}
 
 } // namespace
 
@@ -74,86 +217,81 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
                           const std::string& ylabel, const std::string& y2label,
                           const std::vector<PlotSeries>& series,
                           const std::vector<PlotMarker>& markers, double y_top) {
-  const double W = 760, H = 480, L = 80, R = y2label.empty() ? 30 : 80, T = 50, B = 60;
-  Range1 rx, ry, ry2;
+  PlotFrame f;
+  f.R = y2label.empty() ? 30 : 80;
   bool has2 = false;
-  for (const PlotSeries& s : series)
-    for (std::size_t i = 0; i < s.x.size() && i < s.y.size(); ++i) {
-      rx.add(s.x[i]);
-      (s.right_axis ? ry2 : ry).add(s.y[i]);
-      has2 = has2 || s.right_axis;
+  for (const PlotSeries& p : series)
+    for (std::size_t i = 0; i < p.x.size() && i < p.y.size(); ++i) {
+      f.rx.add(p.x[i]);
+      (p.right_axis ? f.ry2 : f.ry).add(p.y[i]);
+      has2 = has2 || p.right_axis;
     }
-  rx.finish();
   if (std::isfinite(y_top))
-    ry.add(y_top);
-  ry.finish();
-  ry2.finish();
-  const double pw = W - L - R, ph = H - T - B;
-  auto X = [&](double v) { return L + (v - rx.lo) / (rx.hi - rx.lo) * pw; };
-  auto Y = [&](double v, bool right) {
-    const Range1& r = right ? ry2 : ry;
-    return T + ph - (v - r.lo) / (r.hi - r.lo) * ph;
-  };
-  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + num(W) + "\" height=\"" +
-                  num(H) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
+    f.ry.add(y_top);
+  f.rx.finish(), f.ry.finish(), f.ry2.finish();
+  const LegendBox lg = place_legend(f, series, markers);
+  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + num(f.W) + "\" height=\"" +
+                  num(f.H) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";
   s += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  s += "<text x=\"" + num(W / 2) + "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">" +
+  s += "<text x=\"" + num(f.W / 2) + "\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">" +
        escape(title) + "</text>\n";
-  // grid and ticks
-  const double sx = tick_step(rx.hi - rx.lo), sy = tick_step(ry.hi - ry.lo);
-  for (double v = rx.lo; v <= rx.hi + 1e-9 * sx; v += sx) {
-    s += "<line x1=\"" + num(X(v)) + "\" y1=\"" + num(T) + "\" x2=\"" + num(X(v)) + "\" y2=\"" +
-         num(T + ph) + "\" stroke=\"#e0e0e0\"/>\n";
-    s += "<text x=\"" + num(X(v)) + "\" y=\"" + num(T + ph + 16) + "\" text-anchor=\"middle\">" +
-         tick_label(v, sx) + "</text>\n";
-  }
-  for (double v = ry.lo; v <= ry.hi + 1e-9 * sy; v += sy) {
-    s += "<line x1=\"" + num(L) + "\" y1=\"" + num(Y(v, false)) + "\" x2=\"" + num(L + pw) +
-         "\" y2=\"" + num(Y(v, false)) + "\" stroke=\"#e0e0e0\"/>\n";
-    s += "<text x=\"" + num(L - 6) + "\" y=\"" + num(Y(v, false) + 4) + "\" text-anchor=\"end\">" +
-         tick_label(v, sy) + "</text>\n";
-  }
-  if (has2) {
-    const double s2 = tick_step(ry2.hi - ry2.lo);
-    for (double v = ry2.lo; v <= ry2.hi + 1e-9 * s2; v += s2)
-      s += "<text x=\"" + num(L + pw + 6) + "\" y=\"" + num(Y(v, true) + 4) + "\">" +
-           tick_label(v, s2) + "</text>\n";
-  }
-  s += "<rect x=\"" + num(L) + "\" y=\"" + num(T) + "\" width=\"" + num(pw) + "\" height=\"" +
-       num(ph) + "\" fill=\"none\" stroke=\"black\"/>\n";
-  s += "<text x=\"" + num(L + pw / 2) + "\" y=\"" + num(H - 18) + "\" text-anchor=\"middle\">" +
-       escape(xlabel) + "</text>\n";
-  s += "<text transform=\"translate(18," + num(T + ph / 2) +
+  s += axes_svg(f, has2);
+  s += "<text x=\"" + num(f.L + f.pw() / 2) + "\" y=\"" + num(f.H - 18) +
+       "\" text-anchor=\"middle\">" + escape(xlabel) + "</text>\n";
+  s += "<text transform=\"translate(18," + num(f.T + f.ph() / 2) +
        ") rotate(-90)\" text-anchor=\"middle\">" + escape(ylabel) + "</text>\n";
   if (has2)
-    s += "<text transform=\"translate(" + num(W - 14) + "," + num(T + ph / 2) +
+    s += "<text transform=\"translate(" + num(f.W - 14) + "," + num(f.T + f.ph() / 2) +
          ") rotate(90)\" text-anchor=\"middle\">" + escape(y2label) + "</text>\n";
-  // series and legend
-  double ly = T + 14;
+  double ly = lg.y + 8;
   for (const PlotSeries& p : series) {
     std::string pts;
     for (std::size_t i = 0; i < p.x.size() && i < p.y.size(); ++i)
       if (std::isfinite(p.x[i]) && std::isfinite(p.y[i]))
-        pts += num(X(p.x[i])) + "," + num(Y(p.y[i], p.right_axis)) + " ";
-    s += "<polyline fill=\"none\" stroke=\"" + p.color + "\" stroke-width=\"1.6\"" +
-         (p.dashed ? " stroke-dasharray=\"6,4\"" : "") + " points=\"" + pts + "\"/>\n";
-    s += "<line x1=\"" + num(L + 10) + "\" y1=\"" + num(ly) + "\" x2=\"" + num(L + 34) +
-         "\" y2=\"" + num(ly) + "\" stroke=\"" + p.color + "\" stroke-width=\"2\"" +
-         (p.dashed ? " stroke-dasharray=\"6,4\"" : "") + "/>\n";
-    s += "<text x=\"" + num(L + 40) + "\" y=\"" + num(ly + 4) + "\">" + escape(p.label) +
+        pts += num(f.X(p.x[i])) + "," + num(f.Y(p.y[i], p.right_axis)) + " ";
+    s += "<polyline fill=\"none\" stroke=\"" + p.color + "\" stroke-width=\"1.6\"" + dash(p) +
+         " points=\"" + pts + "\"/>\n";
+    s += "<line class=\"legend\" x1=\"" + num(lg.x + 2) + "\" y1=\"" + num(ly) + "\" x2=\"" +
+         num(lg.x + 26) + "\" y2=\"" + num(ly) + "\" stroke=\"" + p.color +
+         "\" stroke-width=\"2\"" + dash(p) + "/>\n";
+    s += "<text x=\"" + num(lg.x + 32) + "\" y=\"" + num(ly + 4) + "\">" + escape(p.label) +
          "</text>\n";
     ly += 16;
   }
   for (const PlotMarker& m : markers) {
-    s += "<circle cx=\"" + num(X(m.x)) + "\" cy=\"" + num(Y(m.y, false)) +
+    s += "<circle cx=\"" + num(f.X(m.x)) + "\" cy=\"" + num(f.Y(m.y, false)) +
          "\" r=\"4\" fill=\"none\" stroke=\"black\"/>\n";
-    const bool right = X(m.x) > L + 0.85 * pw; // keep the label inside the picture
-    s += "<text x=\"" + num(X(m.x) + (right ? -6 : 6)) + "\" y=\"" + num(Y(m.y, false) - 6) + "\"" +
-         (right ? " text-anchor=\"end\"" : "") + ">" + escape(m.label) + "</text>\n";
+    const bool right = f.X(m.x) > f.L + 0.85 * f.pw(); // keep the label inside the picture
+    s += "<text x=\"" + num(f.X(m.x) + (right ? -6 : 6)) + "\" y=\"" + num(f.Y(m.y, false) - 6) +
+         "\"" + (right ? " text-anchor=\"end\"" : "") + ">" + escape(m.label) + "</text>\n";
   }
   s += "</svg>\n";
   return s;
 }
+
+namespace {
+
+// Fracture events of two or more contacts: a disc whose area grows with the number of contacts.
+// Returns how many were drawn.
+template <class FX, class FY, class In>
+std::size_t draw_events(std::string& s, const Snapshot& snap, double scale, FX X, FY Y,
+                        In in_section, int vx, int vy) {
+  double rmean = 0;
+  for (double r : snap.radius)
+    rmean += r / static_cast<double>(snap.radius.size());
+  std::size_t events_shown = 0;
+  for (const EventGlyph& e : snap.events) {
+    if (e.contacts < 2 || !in_section(e.position))
+      continue;
+    ++events_shown;
+    s += "<circle class=\"event\" cx=\"" + num(X(e.position[vx])) + "\" cy=\"" +
+         num(Y(e.position[vy])) + "\" r=\"" + num(0.6 * rmean * scale * std::sqrt(e.contacts)) +
+         "\" fill=\"#ff9900\" fill-opacity=\"0.25\" stroke=\"#cc6600\" stroke-width=\"1\"/>\n";
+  }
+  return events_shown;
+}
+
+} // namespace
 
 std::string crack_map_svg(const Snapshot& snap, const std::string& title, int depth_axis) {
   // View: 2D as is (x right, y up). 3D: a thin section through the centre, seen along the depth
@@ -200,34 +338,48 @@ std::string crack_map_svg(const Snapshot& snap, const std::string& title, int de
          "\" r=\"" + num(r * scale) + "\"/>\n";
   }
   s += "</g>\n";
+  const std::size_t events_shown = draw_events(s, snap, scale, X, Y, in_section, vx, vy);
+  // One crack per broken contact when known (a flat joint's elements merged; its opacity grows
+  // with the contact's damage), else every crack record.
+  const bool per_contact = !snap.contact_cracks.empty();
+  const std::vector<CrackGlyph>& cracks = per_contact ? snap.contact_cracks : snap.cracks;
   std::size_t shown = 0;
-  for (const CrackGlyph& c : snap.cracks) {
+  for (const CrackGlyph& c : cracks) {
     if (!in_section(c.position))
       continue;
     ++shown;
     const char* color = c.mode == 1 ? "#d62728" : "#1f3fbf";
+    const std::string opacity =
+        per_contact
+            ? " stroke-opacity=\"" + num(0.35 + 0.65 * std::clamp(c.damage, 0.0, 1.0)) + "\""
+            : "";
     const double r = 0.5 * c.size * scale;
     const double px = c.position[vx], py = c.position[vy];
     const double nx = c.normal[vx], ny = c.normal[vy];
     const double len = std::hypot(nx, ny);
     if (len < 0.2) { // (3D) a crack nearly in the section plane
       s += "<circle cx=\"" + num(X(px)) + "\" cy=\"" + num(Y(py)) + "\" r=\"" + num(r) +
-           "\" fill=\"none\" stroke=\"" + color + "\" stroke-width=\"1\"/>\n";
+           "\" fill=\"none\" stroke=\"" + color + "\" stroke-width=\"1\"" + opacity + "/>\n";
       continue;
     }
     const double tx = -ny / len, ty = nx / len;
     s += "<line x1=\"" + num(X(px) - r * tx) + "\" y1=\"" + num(Y(py) + r * ty) + "\" x2=\"" +
          num(X(px) + r * tx) + "\" y2=\"" + num(Y(py) - r * ty) + "\" stroke=\"" + color +
-         "\" stroke-width=\"1.5\"/>\n";
+         "\" stroke-width=\"1.5\"" + opacity + "/>\n";
   }
   s += "<text x=\"" + num(margin) + "\" y=\"" + num(H - 6) +
        "\" fill=\"#d62728\">tension</text><text x=\"" + num(margin + 70) + "\" y=\"" + num(H - 6) +
-       "\" fill=\"#1f3fbf\">shear</text>\n";
+       "\" fill=\"#1f3fbf\">shear</text>";
+  if (!snap.events.empty())
+    s += "<text x=\"" + num(margin + 130) + "\" y=\"" + num(H - 6) +
+         "\" fill=\"#cc6600\">fracture events (2+ contacts)</text>";
+  s += "\n";
+  const std::string what = per_contact ? " broken contacts" : " cracks";
   if (snap.dim == 3)
     s += "<text x=\"" + num(margin) + "\" y=\"" + num(H + 10) + "\" fill=\"#555555\">section |" +
          std::string(1, "xyz"[dz]) + " - " + num(1e3 * mid) + " mm| &lt;= " + num(1e3 * half) +
-         " mm: " + std::to_string(shown) + " of " + std::to_string(snap.cracks.size()) +
-         " cracks</text>\n";
+         " mm: " + std::to_string(shown) + " of " + std::to_string(cracks.size()) + what +
+         (snap.events.empty() ? "" : ", " + std::to_string(events_shown) + " events") + "</text>\n";
   s += "</svg>\n";
   return s;
 }

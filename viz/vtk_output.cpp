@@ -1,13 +1,17 @@
 #include "viz/vtk_output.hpp"
 
 #include "io/output_dir.hpp"
+#include "viz/vtk_write.hpp"
 
 #include <algorithm>
+
+#include <Eigen/Eigenvalues>
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
 #include <vtkIntArray.h>
 #include <vtkLongLongArray.h>
 #include <vtkNew.h>
@@ -28,59 +32,46 @@
 
 namespace rocklab {
 
-namespace {
+using namespace vtkw;
 
-constexpr double kPi = std::numbers::pi;
-
-vtkNew<vtkDoubleArray> vector_array(const char* name, const std::vector<Vec3>& v) {
-  vtkNew<vtkDoubleArray> a;
-  a->SetName(name);
-  a->SetNumberOfComponents(3);
-  a->SetNumberOfTuples(static_cast<vtkIdType>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i)
-    a->SetTuple3(static_cast<vtkIdType>(i), v[i].x(), v[i].y(), v[i].z());
-  return a;
+std::vector<Eigen::Matrix3d> grain_stress(const Model& m, double specimen_volume) {
+  const Balls& b = m.balls;
+  std::vector<Eigen::Matrix3d> sum(b.size(), Eigen::Matrix3d::Zero());
+  const auto& cs = m.contacts();
+  const auto& out = m.contact_outputs();
+  for (std::size_t k = 0; k < cs.size() && k < out.size(); ++k) {
+    const Contact& c = cs[k];
+    const Vec3& f2 = out[k].force; // on piece 2; piece 1 gets -f2
+    const auto i = static_cast<std::size_t>(c.end1);
+    sum[i] -= (out[k].xc - b.pos[i]) * f2.transpose();
+    if (c.kind == ContactKind::BallBall) {
+      const auto j = static_cast<std::size_t>(c.end2);
+      sum[j] += (out[k].xc - b.pos[j]) * f2.transpose();
+    }
+  }
+  double solid = 0;
+  std::vector<double> vol(b.size());
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const double r = b.radius[i];
+    vol[i] = m.settings.dim == 2 ? kPi * r * r : 4.0 / 3.0 * kPi * r * r * r;
+    solid += vol[i];
+  }
+  const double fraction = specimen_volume > 0 ? solid / specimen_volume : 1.0;
+  for (std::size_t i = 0; i < b.size(); ++i) // compression positive: minus the tension-positive
+    sum[i] = -fraction / vol[i] * 0.5 * (sum[i] + sum[i].transpose());
+  return sum;
 }
 
-template <class T, class Arr> vtkNew<Arr> scalar_array(const char* name, const std::vector<T>& v) {
-  vtkNew<Arr> a;
-  a->SetName(name);
-  a->SetNumberOfTuples(static_cast<vtkIdType>(v.size()));
-  for (std::size_t i = 0; i < v.size(); ++i)
-    a->SetValue(static_cast<vtkIdType>(i), v[i]);
-  return a;
-}
-
-// One VTK XML file (appended raw data); a failed write is our OutputError, not VTK's log.
-template <class Writer> void write_xml(vtkDataObject* data, const std::filesystem::path& p) {
-  vtkObject::GlobalWarningDisplayOff();
-  vtkNew<Writer> w;
-  w->SetFileName(p.string().c_str());
-  w->SetInputData(data);
-  w->SetDataModeToAppended();
-  w->EncodeAppendedDataOff();
-  if (w->Write() != 1)
-    throw OutputError(p.string() + ": VTK could not write the file (disk full?)");
-}
-
-void write_poly(vtkPolyData* pd, const std::filesystem::path& p) {
-  write_xml<vtkXMLPolyDataWriter>(pd, p);
-}
-
-// Two unit vectors spanning the plane normal to n.
-void plane_axes(const Vec3& n, Vec3& u, Vec3& v) {
-  u = n.unitOrthogonal();
-  v = n.cross(u);
-}
-
-} // namespace
-
-Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, double axial_strain) {
+Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, double axial_strain,
+                       double axial_stress, double specimen_volume) {
   Snapshot s;
   s.dim = m.settings.dim;
   s.time = m.time();
   s.step = m.step();
   s.axial_strain = axial_strain;
+  s.axial_stress = axial_stress;
+  s.stress = grain_stress(m, specimen_volume);
+  std::vector<int> parts(m.balls.size(), 0), broken(m.balls.size(), 0);
   const Balls& b = m.balls;
   s.pos = b.pos;
   s.vel = b.vel;
@@ -105,7 +96,13 @@ Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, doubl
     s.bond_model.push_back(static_cast<std::int32_t>(c.model));
     s.bond_state.push_back(v.intact == 0 ? 0 : (v.broken == 0 ? 2 : 1));
     s.broken_fraction.push_back(static_cast<double>(v.broken) / static_cast<double>(v.parts));
+    for (const auto e : {c.end1, c.end2}) {
+      parts[static_cast<std::size_t>(e)] += v.parts;
+      broken[static_cast<std::size_t>(e)] += v.broken;
+    }
   }
+  for (std::size_t i = 0; i < b.size(); ++i)
+    s.bond_damage.push_back(parts[i] > 0 ? static_cast<double>(broken[i]) / parts[i] : 0.0);
   s.walls = m.walls;
   double lo = 1e300, hi = -1e300;
   for (std::size_t i = 0; i < b.size(); ++i) {
@@ -118,27 +115,29 @@ Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, doubl
 
 namespace {
 
-// Points and cells of one polydata file (the set-up every series but the grains shares).
-struct PolyBuilder {
-  vtkNew<vtkPoints> pts;
-  vtkNew<vtkCellArray> cells;
-  vtkNew<vtkPolyData> pd;
-
-  PolyBuilder() { pts->SetDataTypeToDouble(); }
-  vtkIdType point(const Vec3& x) { return pts->InsertNextPoint(x.x(), x.y(), x.z()); }
-  /// The cells are lines (2D pictures, bonds) or polygons.
-  void write(const std::filesystem::path& path, bool as_lines) {
-    pd->SetPoints(pts);
-    if (as_lines)
-      pd->SetLines(cells);
-    else
-      pd->SetPolys(cells);
-    write_poly(pd, path);
+// A grain's stress tensor (9 components), its principal stresses (sigma1 >= sigma2 >= sigma3),
+// mean stress and von Mises stress [Pa], compression positive.
+void add_stress_arrays(vtkPointData* pd, const std::vector<Eigen::Matrix3d>& st) {
+  vtkNew<vtkDoubleArray> t, p;
+  t->SetName("stress");
+  t->SetNumberOfComponents(9);
+  p->SetName("principal_stress");
+  p->SetNumberOfComponents(3);
+  std::vector<double> mean, mises;
+  for (const Eigen::Matrix3d& m : st) {
+    t->InsertNextTuple(m.data());
+    const Eigen::Vector3d ev = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m).eigenvalues();
+    p->InsertNextTuple3(ev[2], ev[1], ev[0]);
+    mean.push_back(m.trace() / 3);
+    mises.push_back(
+        std::sqrt(0.5 * ((ev[0] - ev[1]) * (ev[0] - ev[1]) + (ev[1] - ev[2]) * (ev[1] - ev[2]) +
+                         (ev[2] - ev[0]) * (ev[2] - ev[0]))));
   }
-  template <class T, class Arr> void cell_array(const char* name, const std::vector<T>& v) {
-    pd->GetCellData()->AddArray(scalar_array<T, Arr>(name, v));
-  }
-};
+  pd->AddArray(t);
+  pd->AddArray(p);
+  pd->AddArray(scalar_array<double, vtkDoubleArray>("mean_stress", mean));
+  pd->AddArray(scalar_array<double, vtkDoubleArray>("von_mises_stress", mises));
+}
 
 // Grains: one vertex cell per grain.
 void write_grains(const Snapshot& s, const std::filesystem::path& path) {
@@ -169,6 +168,20 @@ void write_grains(const Snapshot& s, const std::filesystem::path& path) {
     if (s.dim == 3)
       pd->AddArray(vector_array("rotation_vector", s.rotation));
   }
+  if (!s.stress.empty())
+    add_stress_arrays(pd, s.stress);
+  if (!s.bond_damage.empty())
+    pd->AddArray(scalar_array<double, vtkDoubleArray>("bond_damage", s.bond_damage));
+  add_frame_fields(ug, s);
+  if (s.outline.dim > 0) { // the outline the cells are clipped to (vtk_fractures.cpp)
+    const ClipShape& c = s.outline;
+    vtkNew<vtkDoubleArray> a;
+    a->SetName("outline");
+    for (double v : {static_cast<double>(c.round), c.lo.x(), c.lo.y(), c.lo.z(), c.hi.x(), c.hi.y(),
+                     c.hi.z(), c.center.x(), c.center.y(), c.radius})
+      a->InsertNextValue(v);
+    ug->GetFieldData()->AddArray(a);
+  }
   write_xml<vtkXMLUnstructuredGridWriter>(ug, path);
 }
 
@@ -182,39 +195,8 @@ void write_bonds(const Snapshot& s, const std::filesystem::path& path) {
   b.cell_array<std::int32_t, vtkIntArray>("bond_state", s.bond_state);
   b.cell_array<double, vtkDoubleArray>("broken_fraction", s.broken_fraction);
   b.cell_array<std::int32_t, vtkIntArray>("model", s.bond_model);
+  add_frame_fields(b.pd, s);
   b.write(path, true);
-}
-
-// Cracks: 3D disks as 16-gons, 2D segments in the xy plane.
-void write_cracks(const Snapshot& s, const std::filesystem::path& path) {
-  PolyBuilder b;
-  std::vector<std::int32_t> mode;
-  std::vector<double> time, size;
-  for (const CrackGlyph& c : s.cracks) {
-    const double r = 0.5 * c.size;
-    if (s.dim == 2) {
-      const Vec3 t(-c.normal.y(), c.normal.x(), 0);
-      const vtkIdType ids[2] = {b.point(c.position - r * t), b.point(c.position + r * t)};
-      b.cells->InsertNextCell(2, ids);
-    } else {
-      Vec3 u, v;
-      plane_axes(c.normal, u, v);
-      constexpr int kSides = 16;
-      vtkIdType ids[kSides];
-      for (int k = 0; k < kSides; ++k) {
-        const double a = 2 * kPi * k / kSides;
-        ids[k] = b.point(c.position + r * (std::cos(a) * u + std::sin(a) * v));
-      }
-      b.cells->InsertNextCell(kSides, ids);
-    }
-    mode.push_back(c.mode);
-    time.push_back(c.time);
-    size.push_back(c.size);
-  }
-  b.cell_array<std::int32_t, vtkIntArray>("mode", mode);
-  b.cell_array<double, vtkDoubleArray>("time", time);
-  b.cell_array<double, vtkDoubleArray>("size", size);
-  b.write(path, s.dim == 2);
 }
 
 // A cylinder wall as a 48-sided prism (2D: a polygon of segments).
@@ -262,6 +244,7 @@ void write_walls(const Snapshot& s, const std::filesystem::path& path) {
     }
   }
   b.cell_array<std::int32_t, vtkIntArray>("wall", wall_index);
+  add_frame_fields(b.pd, s);
   b.write(path, s.dim == 2);
 }
 
@@ -278,7 +261,7 @@ std::vector<std::string> VtkSeries::write(const Snapshot& s, const std::string& 
       std::string("cracks_") + index + ".vtp", std::string("walls_") + index + ".vtp"};
   write_grains(s, dir_ / names[0]);
   write_bonds(s, dir_ / names[1]);
-  write_cracks(s, dir_ / names[2]);
+  write_cracks(s.cracks, s, false, dir_ / names[2]);
   write_walls(s, dir_ / names[3]);
   if (tag.empty())
     times_.push_back(s.time);
@@ -289,7 +272,10 @@ std::vector<std::string> VtkSeries::write(const Snapshot& s, const std::string& 
 
 std::vector<std::string> VtkSeries::write_collections() const {
   std::vector<std::string> out;
-  for (const char* series : {"grains", "bonds", "cracks", "walls"}) {
+  std::vector<const char*> all = {"grains", "bonds", "cracks", "walls"};
+  if (fractures_)
+    all.insert(all.end(), {"cells", "contact_cracks", "events"});
+  for (const char* series : all) {
     const char* ext = std::string(series) == "grains" ? "vtu" : "vtp";
     std::string text = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "
                        "byte_order=\"LittleEndian\">\n  <Collection>\n";
@@ -342,6 +328,11 @@ VtkFileInfo read_vtk_info(const std::string& path) {
     ds = pr->GetOutput();
   }
   info.points = ds->GetNumberOfPoints();
+  for (vtkIdType i = 0; i < ds->GetNumberOfPoints(); ++i) {
+    double x[3];
+    ds->GetPoint(i, x);
+    info.positions.emplace_back(x[0], x[1], x[2]);
+  }
   info.cells = ds->GetNumberOfCells();
   const auto arrays = [](vtkFieldData* data, std::vector<std::string>& names,
                          std::map<std::string, std::vector<double>>& values) {
@@ -355,6 +346,23 @@ VtkFileInfo read_vtk_info(const std::string& path) {
   };
   arrays(ds->GetPointData(), info.point_arrays, info.point_values);
   arrays(ds->GetCellData(), info.cell_arrays, info.cell_values);
+  vtkPointData* pd = ds->GetPointData();
+  for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+    if (vtkDataArray* a = pd->GetArray(i); a && a->GetNumberOfComponents() > 1) {
+      auto& v = info.point_tuples[pd->GetArrayName(i)];
+      for (vtkIdType k = 0; k < a->GetNumberOfTuples(); ++k)
+        for (int c = 0; c < a->GetNumberOfComponents(); ++c)
+          v.push_back(a->GetComponent(k, c));
+    }
+  vtkFieldData* fd = ds->GetFieldData();
+  for (int i = 0; i < fd->GetNumberOfArrays(); ++i)
+    if (vtkDataArray* a = fd->GetArray(i); a && a->GetNumberOfTuples() > 0) {
+      info.field_values[fd->GetArrayName(i)] = a->GetComponent(0, 0);
+      auto& v = info.field_tuples[fd->GetArrayName(i)];
+      for (vtkIdType k = 0; k < a->GetNumberOfTuples(); ++k)
+        for (int c = 0; c < a->GetNumberOfComponents(); ++c)
+          v.push_back(a->GetComponent(k, c));
+    }
   return info;
 }
 

@@ -2,6 +2,7 @@
 
 #include "io/output_dir.hpp"
 #include "lab/calibration/report.hpp"
+#include "viz/svg_png.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -136,7 +137,7 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   const fs::path out(o.out_dir);
   write_text_file(out / "card.json", card.dump(2) + "\n");
   write_text_file(out / "convergence.csv", convergence_csv(c, cs.outcome));
-  write_text_file(out / "convergence.svg", convergence_svg(c, cs.outcome));
+  write_svg_and_png(out / "convergence.svg", convergence_svg(c, cs.outcome));
   write_text_file(out / "report.md", report_md(r));
   return cs;
 }

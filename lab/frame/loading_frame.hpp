@@ -156,6 +156,9 @@ public:
   double jaw_radius() const { return p_.jaw_radius_ratio * 0.5 * geo_.width0.x(); }
   /// The current cross-section [m^2] (confined: the walls'; else widened by the lateral strain).
   double current_area(double lateral_strain) const;
+  /// The specimen's volume now [m^3] (2D: area x unit thickness): the current section times the
+  /// actuators' separation; a diametral disk keeps its initial volume.
+  double current_volume() const;
 
   // What the run loop reads.
   bool snapshot_due() const { return snapshot_due_; }

@@ -71,6 +71,12 @@ double LoadingFrame::current_area(double lateral_strain) const {
   return geo_.dim == 2 ? geo_.area0 * f : geo_.area0 * f * f;
 }
 
+double LoadingFrame::current_volume() const {
+  if (geo_.diametral)
+    return geo_.volume;
+  return current_area(current().lateral_strain) * separation();
+}
+
 double LoadingFrame::lateral_strain() const {
   // Compression positive (bulging is negative).
   if (lateral_.empty())

@@ -8,6 +8,7 @@
 #include "io/scene.hpp"
 #include "lab/lab_protocol.hpp"
 #include "viz/svg_plots.hpp"
+#include "viz/svg_png.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -279,11 +280,11 @@ void write_drop_plots(const DropProtocol& p, const std::vector<DropResult>& resu
     law.x.push_back(v);
     law.y.push_back(rocfall_restitution(p.R_N, p.V_half, v) * v);
   }
-  write_text_file(out.staged("restitution.svg"),
-                  line_plot_svg("drop test: bounce velocity vs impact velocity",
-                                "impact velocity [m/s]", "bounce velocity [m/s]", "",
-                                {measured, by_velocity, law}));
-  files.push_back("restitution.svg");
+  const auto [svg, png] = write_svg_and_png(
+      out.staged("restitution.svg"),
+      line_plot_svg("drop test: bounce velocity vs impact velocity", "impact velocity [m/s]",
+                    "bounce velocity [m/s]", "", {measured, by_velocity, law}));
+  files.insert(files.end(), {svg, png});
   if (p.calibrate) {
     PlotSeries fitted{"fitted exponent b", {}, {}, "#d62728"};
     PlotSeries eq36{"thesis Eq. 36 (kn 6.4e10 N/m)", {}, {}, "#7f7f7f", true};
@@ -296,10 +297,11 @@ void write_drop_plots(const DropProtocol& p, const std::vector<DropResult>& resu
       eq36.x.push_back(v);
       eq36.y.push_back(0.0429 * v * v * v - 0.4744 * v * v + 2.5508 * v + 1.1489); // Eq. 36
     }
-    write_text_file(out.staged("exponent.svg"),
-                    line_plot_svg("power-function exponent fitted to Eq. 35",
-                                  "impact velocity [m/s]", "exponent b [-]", "", {fitted, eq36}));
-    files.push_back("exponent.svg");
+    const auto [esvg, epng] = write_svg_and_png(
+        out.staged("exponent.svg"),
+        line_plot_svg("power-function exponent fitted to Eq. 35", "impact velocity [m/s]",
+                      "exponent b [-]", "", {fitted, eq36}));
+    files.insert(files.end(), {esvg, epng});
   }
 }
 

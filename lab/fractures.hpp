@@ -1,0 +1,76 @@
+// From crack records to what a rock engineer reads: one crack per broken contact (its damage =
+// broken parts / parts; a flat joint's elements become one crack) and fracture events, cracks
+// clustered in space and time in the acoustic-emission manner of Hazzard & Young (2000): a crack
+// joins an event when one of its grains is, or touches, a grain of a crack of that event that
+// formed no longer than the event window before it. Units SI.
+#pragma once
+
+#include "lab/crack_monitor.hpp"
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace rocklab {
+
+/// One broken contact as of some time: its element cracks merged.
+struct ContactCrack {
+  std::uint64_t contact = 0;
+  std::int64_t ball1 = 0, ball2 = 0;
+  Vec3 position = Vec3::Zero(); ///< area-weighted centre of its cracks [m]
+  Vec3 normal = Vec3::UnitZ();  ///< the first crack's normal
+  double size = 0;              ///< diameter (3D) / length (2D) of the summed crack area [m]
+  double time = 0;              ///< first break [s]
+  int broken = 0;               ///< parts broken (flat-joint elements; 1 for a point bond)
+  int parts = 1;                ///< parts of the bond
+  int tension = 0, shear = 0;   ///< of the broken parts
+  double energy = 0;            ///< released by its breaks [J]
+  int event = -1;               ///< the event of its first crack
+  double damage() const { return static_cast<double>(broken) / std::max(parts, 1); }
+  int mode() const { return tension >= shear ? 1 : 2; }
+};
+
+/// A fracture event: cracks near in space and time.
+struct FractureEvent {
+  int id = 0;
+  double time = 0;              ///< its first crack [s]
+  double duration = 0;          ///< last crack - first crack [s]
+  Vec3 position = Vec3::Zero(); ///< centroid of its cracks [m]
+  int cracks = 0, contacts = 0, tension = 0, shear = 0;
+  double energy = 0;    ///< strain energy released by its cracks [J]
+  double magnitude = 0; ///< energy magnitude (log10 E = 1.5 M + 4.8, E in J)
+};
+
+struct EventClustering {
+  double window = 0;               ///< [s]
+  std::vector<int> event_of_crack; ///< per crack record
+  std::vector<FractureEvent> events;
+};
+
+/// Pairs of grain ids that touch (contacts of the model, bonded or not).
+using TouchingPairs = std::vector<std::pair<std::int64_t, std::int64_t>>;
+TouchingPairs touching_pairs(const Model& m);
+
+/// Cluster the cracks (in record order, which is time order) into events. Causal: a crack only
+/// looks back, so the events up to a time never change when later cracks come.
+EventClustering cluster_events(const std::vector<Crack>& cracks, const TouchingPairs& touching,
+                               double window);
+
+/// The default window: the time a P wave, speed sqrt(E / rho) with the test's modulus and the
+/// specimen's bulk density, takes to cross `diameters` mean grain diameters.
+double default_event_window(double youngs_modulus, double bulk_density, double mean_diameter,
+                            double diameters = 5);
+
+/// The broken contacts as of `until` (cracks with time <= until), in order of first break. Size:
+/// 3D the diameter of the summed crack area, 2D the summed length.
+std::vector<ContactCrack> contact_cracks(const std::vector<Crack>& cracks,
+                                         const EventClustering& ev, double until, int dim);
+
+/// The events as of `until` (their cracks up to then).
+std::vector<FractureEvent> events_until(const std::vector<Crack>& cracks, const EventClustering& ev,
+                                        double until);
+
+/// events.csv: one row per event, SI units.
+std::string events_csv(const std::vector<FractureEvent>& events);
+
+} // namespace rocklab

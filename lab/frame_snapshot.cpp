@@ -1,0 +1,95 @@
+#include "lab/frame_snapshot.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace rocklab {
+
+ClipShape specimen_outline(const LoadingFrame& f) {
+  const SpecimenGeometry& g = f.geometry();
+  const Balls& b = f.model().balls;
+  ClipShape c;
+  c.dim = g.dim;
+  c.round = g.round || g.diametral;
+  c.lo = g.lo, c.hi = g.hi;
+  c.center = Vec3(g.center.x(), g.center.y(), 0);
+  if (g.diametral) {
+    c.radius = 0.25 * (g.width0.x() + g.width0.y());
+    c.fit_round_box();
+    return c;
+  }
+  const int a = g.axis;
+  double lo = 1e300, hi = -1e300;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    lo = std::min(lo, b.pos[i][a] - b.radius[i]), hi = std::max(hi, b.pos[i][a] + b.radius[i]);
+  const double area = f.current_area(f.current().lateral_strain), h = f.current_volume() / area;
+  c.lo[a] = 0.5 * (lo + hi) - 0.5 * h, c.hi[a] = 0.5 * (lo + hi) + 0.5 * h;
+  if (c.round) {
+    c.radius = std::sqrt(area / std::numbers::pi);
+    c.fit_round_box();
+  } else {
+    const double scale = std::pow(area / g.area0, g.dim == 2 ? 1.0 : 0.5);
+    for (int d = 0; d < g.dim; ++d)
+      if (d != a) {
+        const double mid = 0.5 * (g.lo[d] + g.hi[d]), half = 0.5 * g.width0[d] * scale;
+        c.lo[d] = mid - half, c.hi[d] = mid + half;
+      }
+  }
+  return c;
+}
+
+Snapshot frame_snapshot(const LoadingFrame& f) {
+  Snapshot s = take_snapshot(f.model(), f.reference_positions(), f.current().axial_strain,
+                             f.current().axial_stress, f.current_volume());
+  s.outline = specimen_outline(f);
+  for (const Crack& c : f.cracks().cracks())
+    s.cracks.push_back({c.position, c.normal, c.size, c.mode, c.time, c.step});
+  return s;
+}
+
+void add_fractures(Snapshot& s, const std::vector<Crack>& cracks, const EventClustering& ev,
+                   double until) {
+  for (const ContactCrack& c : contact_cracks(cracks, ev, until, s.dim)) {
+    s.contact_cracks.push_back(
+        {c.position, c.normal, c.size, c.mode(), c.time, 0, c.damage(), c.event, c.energy});
+    s.contact_crack_grains.push_back({c.ball1, c.ball2});
+  }
+  for (const FractureEvent& e : events_until(cracks, ev, until))
+    s.events.push_back(
+        {e.id, e.position, e.time, e.duration, e.cracks, e.contacts, e.energy, e.magnitude});
+}
+
+EventClustering fracture_events(const LoadingFrame& f, const Protocol& p, nlohmann::json& r) {
+  const Balls& b = f.model().balls;
+  double rsum = 0, rho = 0;
+  for (std::size_t i = 0; i < b.size(); ++i)
+    rsum += b.radius[i], rho += b.density[i];
+  const double n = std::max<double>(1, static_cast<double>(b.size()));
+  double e = r.value("youngs_modulus_Pa", 0.0);
+  std::string method = "output.event_window_s";
+  double window = p.event_window;
+  if (!(window > 0)) {
+    if (!(e > 0) && r.value("peak_axial_strain", 0.0) > 0) // no elastic fit: the peak secant
+      e = r.value("peak_stress_Pa", 0.0) / r.value("peak_axial_strain", 1.0);
+    window = default_event_window(e, rho / n, 2 * rsum / n);
+    method = "5 mean grain diameters / P-wave speed sqrt(E / grain density)";
+  }
+  EventClustering ev = cluster_events(f.cracks().cracks(), touching_pairs(f.model()), window);
+  std::size_t largest = 0;
+  for (const FractureEvent& x : ev.events)
+    largest = std::max(largest, static_cast<std::size_t>(x.cracks));
+  r["fracture_events"] = {
+      {"count", ev.events.size()},
+      {"broken_contacts",
+       contact_cracks(f.cracks().cracks(), ev, INFINITY, f.model().settings.dim).size()},
+      {"window_s", window},
+      {"window_method", method},
+      {"largest_event_cracks", largest},
+      {"method", "a crack joins the event of a crack at the same or a touching grain formed at "
+                 "most window_s before it (after Hazzard & Young 2000); magnitude: log10 E = "
+                 "1.5 M + 4.8 of the released bond strain energy E [J]"}};
+  return ev;
+}
+
+} // namespace rocklab

@@ -1,0 +1,101 @@
+// Plots read back: tick labels true to their positions, data drawn where the ticks say, the
+// legend off the data, a PNG beside each SVG (viz/svg_plots, viz/svg_png).
+#include "helpers.hpp"
+#include "svg_check.hpp"
+#include "viz/svg_plots.hpp"
+#include "viz/svg_png.hpp"
+
+#include <regex>
+
+namespace rocklab {
+namespace {
+
+// The 3D UCS strain axis that printed -0.35 % as "-0.4" and had no 0 tick (issue 14).
+PlotSeries strains() {
+  PlotSeries axial{"axial", {}, {}, "#000000"};
+  PlotSeries lateral{"lateral", {}, {}, "#1f77b4"};
+  for (int i = 0; i <= 50; ++i) {
+    const double s = 0.15 * i / 50.0; // axial strain [%]
+    axial.x.push_back(s), axial.y.push_back(1000 * s);
+    lateral.x.push_back(-0.35 * i / 50.0), lateral.y.push_back(1000 * s);
+  }
+  return axial;
+}
+
+TEST(Plots, TickLabelsAreTheValuesAtTheirPositions) {
+  for (const auto& [lo, hi] : std::vector<std::pair<double, double>>{
+           {-0.35, 0.15}, {0, 173.2}, {-3.1e-4, 2.2e-3}, {12, 12.00001}, {-1, -0.2}, {0, 1e9}}) {
+    PlotSeries s{"data", {}, {}, "#000000"};
+    for (int i = 0; i <= 40; ++i) {
+      const double x = lo + (hi - lo) * i / 40.0;
+      s.x.push_back(x), s.y.push_back(0.5 * x * x - x);
+    }
+    const std::string svg = line_plot_svg("t", "x", "y", "", {s, strains()});
+    EXPECT_TRUE(test::ticks_are_true(svg, "xtick")) << lo << " .. " << hi;
+    EXPECT_TRUE(test::ticks_are_true(svg, "ytick")) << lo << " .. " << hi;
+    // Each data point is drawn where the axes' tick labels say it is.
+    const auto xt = test::svg_ticks(svg, "xtick"), yt = test::svg_ticks(svg, "ytick");
+    const auto lines = test::svg_polylines(svg);
+    ASSERT_EQ(lines.size(), 2u);
+    ASSERT_EQ(lines[0].size(), s.x.size());
+    const double xspan = xt.back().value - xt.front().value;
+    const double yspan = yt.back().value - yt.front().value;
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      EXPECT_NEAR(test::svg_axis_value(xt, lines[0][i].first), s.x[i], 2e-4 * xspan);
+      EXPECT_NEAR(test::svg_axis_value(yt, lines[0][i].second), s.y[i], 2e-4 * yspan);
+    }
+  }
+  // the case of the issue: ticks -0.4 ... 0.2 by 0.1 (or coarser), with a 0 tick
+  PlotSeries lateral{"lateral", {-0.35, 0}, {0, 100}, "#1f77b4"};
+  PlotSeries axial{"axial", {0, 0.15}, {0, 100}, "#000000"};
+  const std::string svg = line_plot_svg("t", "strain [%]", "stress [MPa]", "", {axial, lateral});
+  bool zero = false;
+  for (const auto& t : test::svg_ticks(svg, "xtick"))
+    zero = zero || t.text == "0" || t.text == "0.0" || t.text == "0.00";
+  EXPECT_TRUE(zero);
+}
+
+TEST(Plots, TheLegendIsDrawnOffTheData) {
+  // Data filling the top-left corner (a stress-strain curve) and one filling everything.
+  PlotSeries rising{"rising", {}, {}, "#000000"};
+  for (int i = 0; i <= 100; ++i)
+    rising.x.push_back(i), rising.y.push_back(i);
+  PlotSeries everywhere{"zigzag", {}, {}, "#d62728"};
+  for (int i = 0; i <= 100; ++i)
+    everywhere.x.push_back(i), everywhere.y.push_back(i % 2 ? 100 : 0);
+  for (const auto& series : std::vector<std::vector<PlotSeries>>{{rising}, {rising, everywhere}}) {
+    const std::string svg = line_plot_svg("t", "x", "y", "", series);
+    const std::regex re("<line class=\"legend\" x1=\"([-0-9.]+)\" y1=\"([-0-9.]+)\" "
+                        "x2=\"([-0-9.]+)\"");
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(svg, m, re));
+    const double lx = std::stod(m[1]), ly = std::stod(m[2]);
+    const double lw = 32 + 7 * 7, lh = 16 * static_cast<double>(series.size());
+    for (const auto& line : test::svg_polylines(svg))
+      for (std::size_t i = 1; i < line.size(); ++i)
+        for (int k = 0; k <= 20; ++k) {
+          const double x = line[i - 1].first + (line[i].first - line[i - 1].first) * k / 20.0;
+          const double y = line[i - 1].second + (line[i].second - line[i - 1].second) * k / 20.0;
+          EXPECT_FALSE(x > lx && x < lx + lw && y > ly - 8 && y < ly - 8 + lh)
+              << "data at (" << x << ", " << y << ") under the legend";
+        }
+  }
+}
+
+TEST(Plots, APngIsWrittenBesideEachSvg) {
+  const auto dir = test::scratch_root() / "plots_png";
+  std::filesystem::create_directories(dir);
+  const auto [svg, png] =
+      write_svg_and_png(dir / "curve.svg", line_plot_svg("t", "x", "y", "", {strains()}));
+  EXPECT_EQ(svg, "curve.svg");
+  EXPECT_EQ(png, "curve.png");
+  const auto [w, h] = png_size(dir / "curve.png");
+  EXPECT_EQ(w, 2 * 760); // twice the SVG's pixel size
+  EXPECT_EQ(h, 2 * 480);
+  // The PNG is not blank: its compressed size grows with what is drawn on it.
+  EXPECT_GT(std::filesystem::file_size(dir / "curve.png"), 10000u);
+  EXPECT_THROW(write_png_of_svg("<svg", dir / "bad.png"), std::runtime_error);
+}
+
+} // namespace
+} // namespace rocklab

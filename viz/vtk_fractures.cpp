@@ -1,0 +1,225 @@
+#include "io/output_dir.hpp"
+#include "viz/power_cells.hpp"
+#include "viz/vtk_output.hpp"
+#include "viz/vtk_write.hpp"
+
+#include <vtkPointData.h>
+
+#include <map>
+
+namespace rocklab {
+
+namespace vtkw {
+
+// Cracks: 3D disks as 16-gons, 2D segments in the xy plane; per-contact cracks with their damage,
+// event and energy.
+void write_cracks(const std::vector<CrackGlyph>& cracks, const Snapshot& frame, bool per_contact,
+                  const std::filesystem::path& path, const std::vector<std::vector<Vec3>>* faces) {
+  const int dim = frame.dim;
+  PolyBuilder b;
+  add_frame_fields(b.pd, frame);
+  std::vector<std::int32_t> mode, event, faced;
+  std::vector<double> time, size, damage, energy;
+  for (std::size_t k = 0; k < cracks.size(); ++k) {
+    const CrackGlyph& c = cracks[k];
+    const double r = 0.5 * c.size;
+    const std::vector<Vec3>* face =
+        faces && k < faces->size() && !(*faces)[k].empty() ? &(*faces)[k] : nullptr;
+    faced.push_back(face != nullptr);
+    if (face) { // the face the two grains' cells share (2D: an edge)
+      std::vector<vtkIdType> ids;
+      for (const Vec3& x : *face)
+        ids.push_back(b.point(x));
+      b.cells->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+    } else if (dim == 2) {
+      const Vec3 t(-c.normal.y(), c.normal.x(), 0);
+      const vtkIdType ids[2] = {b.point(c.position - r * t), b.point(c.position + r * t)};
+      b.cells->InsertNextCell(2, ids);
+    } else {
+      Vec3 u, v;
+      plane_axes(c.normal, u, v);
+      constexpr int kSides = 16;
+      vtkIdType ids[kSides];
+      for (int k = 0; k < kSides; ++k) {
+        const double a = 2 * kPi * k / kSides;
+        ids[k] = b.point(c.position + r * (std::cos(a) * u + std::sin(a) * v));
+      }
+      b.cells->InsertNextCell(kSides, ids);
+    }
+    mode.push_back(c.mode);
+    time.push_back(c.time);
+    size.push_back(c.size);
+    damage.push_back(c.damage);
+    event.push_back(c.event);
+    energy.push_back(c.energy);
+  }
+  b.cell_array<std::int32_t, vtkIntArray>("mode", mode);
+  b.cell_array<double, vtkDoubleArray>("time", time);
+  b.cell_array<double, vtkDoubleArray>("size", size);
+  if (per_contact) {
+    b.cell_array<double, vtkDoubleArray>("damage", damage);
+    b.cell_array<std::int32_t, vtkIntArray>("event", event);
+    b.cell_array<double, vtkDoubleArray>("energy", energy);
+    if (faces)
+      b.cell_array<std::int32_t, vtkIntArray>("faced", faced);
+  }
+  b.write(path, dim == 2);
+}
+
+// Fracture events: one vertex per event at the centroid of its cracks.
+void write_events(const std::vector<EventGlyph>& events, const Snapshot& frame,
+                  const std::filesystem::path& path) {
+  PolyBuilder b;
+  add_frame_fields(b.pd, frame);
+  std::vector<std::int32_t> id, cracks, contacts;
+  std::vector<double> time, duration, energy, magnitude;
+  vtkNew<vtkCellArray> verts;
+  for (const EventGlyph& e : events) {
+    const vtkIdType p = b.point(e.position);
+    verts->InsertNextCell(1, &p);
+    id.push_back(e.id);
+    cracks.push_back(e.cracks);
+    contacts.push_back(e.contacts);
+    time.push_back(e.time);
+    duration.push_back(e.duration);
+    energy.push_back(e.energy);
+    magnitude.push_back(e.magnitude);
+  }
+  b.cell_array<std::int32_t, vtkIntArray>("event", id);
+  b.cell_array<std::int32_t, vtkIntArray>("cracks", cracks);
+  b.cell_array<std::int32_t, vtkIntArray>("contacts", contacts);
+  b.cell_array<double, vtkDoubleArray>("time", time);
+  b.cell_array<double, vtkDoubleArray>("duration", duration);
+  b.cell_array<double, vtkDoubleArray>("energy", energy);
+  b.cell_array<double, vtkDoubleArray>("magnitude", magnitude);
+  b.pd->SetPoints(b.pts);
+  b.pd->SetVerts(verts);
+  write_poly(b.pd, path);
+}
+
+} // namespace vtkw
+
+namespace {
+
+using namespace vtkw;
+
+// One frame's grains read back from its grains file.
+struct FrameGrains {
+  VtkFileInfo info;
+  std::map<std::int64_t, std::int64_t> index; ///< grain id -> point index
+};
+
+FrameGrains read_grains(const std::filesystem::path& file) {
+  FrameGrains g;
+  g.info = read_vtk_info(file.string());
+  const auto& id = g.info.point_values["id"];
+  for (std::size_t i = 0; i < id.size(); ++i)
+    g.index[static_cast<std::int64_t>(id[i])] = static_cast<std::int64_t>(i);
+  return g;
+}
+
+// The cells: 3D every face of every cell (so each grain is a closed polyhedron), 2D one polygon
+// per cell; each carries its grain's index, id, cell volume, whether it lies on the specimen's
+// boundary, and the grain's scalar fields (stresses, bond damage, ...).
+void write_cells(const std::vector<PowerCell>& cells, const FrameGrains& g, const Snapshot& frame,
+                 const std::filesystem::path& path) {
+  PolyBuilder b;
+  add_frame_fields(b.pd, frame);
+  std::vector<std::int32_t> grain, boundary;
+  std::vector<double> volume;
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const PowerCell& c = cells[i];
+    auto add = [&](const std::vector<Vec3>& poly, bool on_boundary) {
+      std::vector<vtkIdType> ids;
+      for (const Vec3& x : poly)
+        ids.push_back(b.point(x));
+      b.cells->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
+      grain.push_back(static_cast<std::int32_t>(i));
+      boundary.push_back(on_boundary);
+      volume.push_back(c.volume);
+    };
+    if (frame.dim == 3) {
+      for (std::size_t k = 0; k < c.faces.size(); ++k)
+        add(c.faces[k], c.neighbour[k] < 0);
+    } else if (!c.faces.empty()) {
+      std::vector<Vec3> poly;
+      bool edge = false;
+      for (std::size_t k = 0; k < c.faces.size(); ++k)
+        poly.push_back(c.faces[k][0]), edge = edge || c.neighbour[k] < 0;
+      add(poly, edge);
+    }
+  }
+  b.cell_array<std::int32_t, vtkIntArray>("grain", grain);
+  b.cell_array<std::int32_t, vtkIntArray>("boundary", boundary);
+  b.cell_array<double, vtkDoubleArray>("cell_volume", volume);
+  for (const auto& [name, values] : g.info.point_values) {
+    std::vector<double> v;
+    for (const std::int32_t i : grain)
+      v.push_back(values[static_cast<std::size_t>(i)]);
+    b.cell_array<double, vtkDoubleArray>(name.c_str(), v);
+  }
+  b.write(path, false);
+}
+
+} // namespace
+
+CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at) {
+  std::filesystem::create_directories(dir_);
+  std::vector<std::pair<std::string, double>> entries; // tagged first: the summary is the last
+  for (const auto& [tag, t] : tagged_)
+    entries.emplace_back(tag, t);
+  for (std::size_t i = 0; i < times_.size(); ++i) {
+    char index[32];
+    std::snprintf(index, sizeof index, "%04zu", i);
+    entries.emplace_back(index, times_[i]);
+  }
+  CellSummary sum;
+  for (const auto& [index, t] : entries) {
+    Snapshot s = at(t);
+    const FrameGrains g = read_grains(dir_ / ("grains_" + index + ".vtu"));
+    s.step = static_cast<std::int64_t>(
+        g.info.field_values.count("step") ? g.info.field_values.at("step") : 0);
+    s.time = t;
+    if (g.info.field_values.count("axial_strain"))
+      s.axial_strain = g.info.field_values.at("axial_strain");
+    if (g.info.field_values.count("axial_stress"))
+      s.axial_stress = g.info.field_values.at("axial_stress");
+    const std::vector<double>& radius = g.info.point_values.at("radius");
+    ClipShape shape = ClipShape::around(g.info.positions, radius, s.dim, s.outline.round);
+    if (const auto o = g.info.field_tuples.find("outline");
+        o != g.info.field_tuples.end() && o->second.size() == 10) {
+      const auto& v = o->second;
+      shape.round = v[0] != 0;
+      shape.lo = Vec3(v[1], v[2], v[3]), shape.hi = Vec3(v[4], v[5], v[6]);
+      shape.center = Vec3(v[7], v[8], 0), shape.radius = v[9];
+    }
+    const std::vector<PowerCell> cells = power_cells(g.info.positions, radius, shape);
+    write_cells(cells, g, s, dir_ / ("cells_" + index + ".vtp"));
+    // each contact crack as its grains' shared face, where their cells touch
+    std::vector<std::vector<Vec3>> faces(s.contact_cracks.size());
+    std::size_t faced = 0;
+    for (std::size_t k = 0; k < s.contact_cracks.size() && k < s.contact_crack_grains.size(); ++k) {
+      const auto a = g.index.find(s.contact_crack_grains[k][0]);
+      const auto b = g.index.find(s.contact_crack_grains[k][1]);
+      if (a == g.index.end() || b == g.index.end())
+        continue;
+      if (const auto* f = cells[static_cast<std::size_t>(a->second)].face_with(b->second)) {
+        faces[k] = *f;
+        ++faced;
+      }
+    }
+    write_cracks(s.contact_cracks, s, true, dir_ / ("contact_cracks_" + index + ".vtp"), &faces);
+    write_events(s.events, s, dir_ / ("events_" + index + ".vtp"));
+    sum = {};
+    sum.grains = cells.size();
+    for (const PowerCell& c : cells)
+      sum.volume_sum += c.volume, sum.hidden += c.faces.empty();
+    sum.shape_volume = shape.volume();
+    sum.faced_cracks = faced;
+    sum.contact_cracks = s.contact_cracks.size();
+  }
+  fractures_ = true;
+  return sum;
+}
+
+} // namespace rocklab
