@@ -431,18 +431,25 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
               static_cast<long long>(c["tension"].get<std::int64_t>()),
               static_cast<long long>(c["shear"].get<std::int64_t>()),
               static_cast<long long>(c["at_peak"]["total"].get<std::int64_t>()));
+  if (r.contains("fracture_events")) {
+    const auto& e = r["fracture_events"];
+    std::printf("fractures    %zu broken contacts in %zu events (largest %zu cracks; window %.3g s)"
+                "\n",
+                e["broken_contacts"].get<std::size_t>(), e["count"].get<std::size_t>(),
+                e["largest_event_cracks"].get<std::size_t>(), e["window_s"].get<double>());
+  }
   std::printf("stopped      %s\n", r["stop_reason"].get<std::string>().c_str());
   std::printf("wall time    %.1f s on %d thread(s)\n", s.wall_seconds, omp_get_max_threads());
-  std::printf("results      %s/results.json  %s/history.csv  %s/cracks.csv\n", out_dir.c_str(),
-              out_dir.c_str(), out_dir.c_str());
+  std::printf("results      %s/results.json  %s/history.csv  %s/cracks.csv  %s/events.csv\n",
+              out_dir.c_str(), out_dir.c_str(), out_dir.c_str(), out_dir.c_str());
   for (const auto& f : r["files"]) {
     const std::string name = f.get<std::string>();
     if (name.ends_with(".svg"))
-      std::printf("plot         %s/%s\n", out_dir.c_str(), name.c_str());
+      std::printf("plot         %s/%s (and .png)\n", out_dir.c_str(), name.c_str());
     else if (name == "vtk/grains.pvd")
-      std::printf("ParaView     %s/vtk/grains.pvd (also bonds.pvd, cracks.pvd, walls.pvd; "
-                  "viz/rocklab_paraview.py sets up the view)\n",
-                  out_dir.c_str());
+      std::printf("ParaView     %s/vtk/grains.pvd (also cells, contact_cracks, events, bonds, "
+                  "cracks, walls; pvpython viz/rocklab_paraview.py %s sets up the view)\n",
+                  out_dir.c_str(), out_dir.c_str());
   }
 }
 

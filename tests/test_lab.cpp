@@ -169,7 +169,8 @@ TEST(Lab, UcsWritesResultsCracksAndReadableParaViewFiles) {
       } else if (std::string(series) == "bonds") {
         EXPECT_GT(info.cells, 0);
         EXPECT_EQ(info.points, 2 * info.cells);
-        for (const char* a : {"bond_state", "broken_fraction"})
+        for (const char* a :
+             {"bond_state", "broken_fraction", "normal_force", "shear_force", "bending_moment"})
           EXPECT_TRUE(has(info.cell_arrays, a)) << a;
       } else if (std::string(series) == "cracks") {
         for (const char* a : {"mode", "time"})

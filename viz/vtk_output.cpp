@@ -96,6 +96,12 @@ Snapshot take_snapshot(const Model& m, const std::vector<Vec3>& reference, doubl
     s.bond_model.push_back(static_cast<std::int32_t>(c.model));
     s.bond_state.push_back(v.intact == 0 ? 0 : (v.broken == 0 ? 2 : 1));
     s.broken_fraction.push_back(static_cast<double>(v.broken) / static_cast<double>(v.parts));
+    const auto k = static_cast<std::size_t>(&c - m.contacts().data());
+    const ContactResult f = local_components(c, m.contact_outputs()[k]);
+    s.normal_force.push_back(f.Fn);
+    s.shear_force.push_back(std::hypot(f.Fss, f.Fst));
+    s.twisting_moment.push_back(std::abs(f.Mt));
+    s.bending_moment.push_back(std::hypot(f.Mbs, f.Mbt));
     for (const auto e : {c.end1, c.end2}) {
       parts[static_cast<std::size_t>(e)] += v.parts;
       broken[static_cast<std::size_t>(e)] += v.broken;
@@ -195,6 +201,10 @@ void write_bonds(const Snapshot& s, const std::filesystem::path& path) {
   b.cell_array<std::int32_t, vtkIntArray>("bond_state", s.bond_state);
   b.cell_array<double, vtkDoubleArray>("broken_fraction", s.broken_fraction);
   b.cell_array<std::int32_t, vtkIntArray>("model", s.bond_model);
+  b.cell_array<double, vtkDoubleArray>("normal_force", s.normal_force);
+  b.cell_array<double, vtkDoubleArray>("shear_force", s.shear_force);
+  b.cell_array<double, vtkDoubleArray>("twisting_moment", s.twisting_moment);
+  b.cell_array<double, vtkDoubleArray>("bending_moment", s.bending_moment);
   add_frame_fields(b.pd, s);
   b.write(path, true);
 }

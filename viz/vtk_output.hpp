@@ -65,6 +65,9 @@ struct Snapshot {
   std::vector<std::int32_t> bond_model;
   std::vector<std::int32_t> bond_state; ///< 0 no bonded part left, 1 partly, 2 intact
   std::vector<double> broken_fraction;  ///< broken parts / parts (flat joints: elements)
+  /// the contact's force and moment on grain 2 in contact-plane terms: normal force (tension
+  /// positive) [N], shear force magnitude [N], twisting and bending moment magnitudes [N m]
+  std::vector<double> normal_force, shear_force, twisting_moment, bending_moment;
   // walls (platens, confinement)
   std::vector<Wall> walls;
   double wall_extent = 1; ///< drawn length of unbounded cylinder walls [m]
