@@ -271,24 +271,32 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
 
 namespace {
 
-// Fracture events of two or more contacts: a disc whose area grows with the number of contacts.
-// Returns how many were drawn.
-template <class FX, class FY, class In>
-std::size_t draw_events(std::string& s, const Snapshot& snap, double scale, FX X, FY Y,
-                        In in_section, int vx, int vy) {
+// The largest fracture events (at most 12, of 5 or more contacts), projected onto the picture: a
+// ring whose area grows with the number of contacts, labelled with it. Returns how many.
+template <class FX, class FY>
+std::size_t draw_events(std::string& s, const Snapshot& snap, double scale, FX X, FY Y, int vx,
+                        int vy) {
   double rmean = 0;
   for (double r : snap.radius)
     rmean += r / static_cast<double>(snap.radius.size());
-  std::size_t events_shown = 0;
-  for (const EventGlyph& e : snap.events) {
-    if (e.contacts < 2 || !in_section(e.position))
-      continue;
-    ++events_shown;
-    s += "<circle class=\"event\" cx=\"" + num(X(e.position[vx])) + "\" cy=\"" +
-         num(Y(e.position[vy])) + "\" r=\"" + num(0.6 * rmean * scale * std::sqrt(e.contacts)) +
-         "\" fill=\"#ff9900\" fill-opacity=\"0.25\" stroke=\"#cc6600\" stroke-width=\"1\"/>\n";
+  std::vector<const EventGlyph*> big;
+  for (const EventGlyph& e : snap.events)
+    if (e.contacts >= 5)
+      big.push_back(&e);
+  std::stable_sort(big.begin(), big.end(), [](const EventGlyph* a, const EventGlyph* b) {
+    return a->contacts > b->contacts;
+  });
+  if (big.size() > 12)
+    big.resize(12);
+  for (const EventGlyph* e : big) {
+    const double x = X(e->position[vx]), y = Y(e->position[vy]);
+    const double r = 0.5 * rmean * scale * std::sqrt(e->contacts);
+    s += "<circle class=\"event\" cx=\"" + num(x) + "\" cy=\"" + num(y) + "\" r=\"" + num(r) +
+         "\" fill=\"none\" stroke=\"#ff8c00\" stroke-width=\"2.5\" stroke-opacity=\"0.9\"/>\n";
+    s += "<text x=\"" + num(x + 0.72 * r) + "\" y=\"" + num(y - 0.72 * r) +
+         "\" fill=\"#b35f00\" font-size=\"11\">" + std::to_string(e->contacts) + "</text>\n";
   }
-  return events_shown;
+  return big.size();
 }
 
 } // namespace
@@ -338,7 +346,7 @@ std::string crack_map_svg(const Snapshot& snap, const std::string& title, int de
          "\" r=\"" + num(r * scale) + "\"/>\n";
   }
   s += "</g>\n";
-  const std::size_t events_shown = draw_events(s, snap, scale, X, Y, in_section, vx, vy);
+  const std::size_t events_shown = draw_events(s, snap, scale, X, Y, vx, vy);
   // One crack per broken contact when known (a flat joint's elements merged; its opacity grows
   // with the contact's damage), else every crack record.
   const bool per_contact = !snap.contact_cracks.empty();
@@ -370,16 +378,16 @@ std::string crack_map_svg(const Snapshot& snap, const std::string& title, int de
   s += "<text x=\"" + num(margin) + "\" y=\"" + num(H - 6) +
        "\" fill=\"#d62728\">tension</text><text x=\"" + num(margin + 70) + "\" y=\"" + num(H - 6) +
        "\" fill=\"#1f3fbf\">shear</text>";
-  if (!snap.events.empty())
-    s += "<text x=\"" + num(margin + 130) + "\" y=\"" + num(H - 6) +
-         "\" fill=\"#cc6600\">fracture events (2+ contacts)</text>";
+  if (events_shown > 0)
+    s += "<text x=\"" + num(margin + 130) + "\" y=\"" + num(H - 6) + "\" fill=\"#b35f00\">" +
+         std::to_string(events_shown) + " largest events (contacts)</text>";
   s += "\n";
   const std::string what = per_contact ? " broken contacts" : " cracks";
   if (snap.dim == 3)
-    s += "<text x=\"" + num(margin) + "\" y=\"" + num(H + 10) + "\" fill=\"#555555\">section |" +
-         std::string(1, "xyz"[dz]) + " - " + num(1e3 * mid) + " mm| &lt;= " + num(1e3 * half) +
-         " mm: " + std::to_string(shown) + " of " + std::to_string(cracks.size()) + what +
-         (snap.events.empty() ? "" : ", " + std::to_string(events_shown) + " events") + "</text>\n";
+    s += "<text x=\"" + num(margin) + "\" y=\"" + num(H + 10) + "\" fill=\"#555555\">" +
+         std::to_string(shown) + " of " + std::to_string(cracks.size()) + what + " within " +
+         num(1e3 * half) + " mm of " + std::string(1, "xyz"[dz]) + " = " + num(1e3 * mid) +
+         " mm</text>\n";
   s += "</svg>\n";
   return s;
 }
