@@ -25,9 +25,8 @@ import sys
 
 from paraview import servermanager  # noqa: F401  (ParaView's own modules)
 from paraview.simple import (
-    ColorBy, GetActiveViewOrCreate, GetAnimationScene, GetColorTransferFunction,
-    GetOpacityTransferFunction, GetScalarBar,
-    Glyph, Hide, PVDReader, Render, SaveScreenshot, Show, Text, Threshold)
+    ColorBy, GetActiveViewOrCreate, GetAnimationScene, GetColorTransferFunction, GetScalarBar,
+    Calculator, Glyph, Hide, PVDReader, Render, SaveScreenshot, Show, Text, Threshold)
 
 
 def parse(argv):
@@ -102,7 +101,65 @@ def legend(view, lut, title, position):
     bar.ScalarBarLength = 0.33
     bar.TitleColor = bar.LabelColor = [0.1, 0.1, 0.1]
     bar.TitleFontSize = bar.LabelFontSize = 16
+    bar.RangeLabelFormat = "%.3g"
     return bar
+
+
+def threshold(source, array, lo, hi):
+    t = Threshold(Input=source)
+    t.Scalars = ["CELLS", array]
+    try:
+        t.LowerThreshold, t.UpperThreshold = lo, hi
+    except AttributeError:  # ParaView < 5.10
+        t.ThresholdRange = [lo, hi]
+    return t
+
+
+def show_cracks(view, cracks, field, results, times, dim):
+    """One crack per broken contact, in a palette the grains do not use. A 3D test with many
+    cracks and a post-peak part: the cracks formed after the peak (where the macro-fracture
+    grows) opaque and coloured by their time, the earlier, scattered microcracks faint grey."""
+    if times:
+        cracks.UpdatePipeline(times[-1])
+    t0, t1 = series_range(cracks, "CELLS", "time", times)
+    tp = results.get("peak_time_s")
+    split = (field == "time" and dim == 3 and tp is not None and t0 < tp < t1 and
+             cracks.GetDataInformation().GetNumberOfCells() > 400)
+    shown = cracks
+    if split:
+        early = threshold(cracks, "time", t0, tp)
+        ed = Show(early, view)
+        ed.ColorArrayName = ["POINTS", ""]
+        ed.AmbientColor = ed.DiffuseColor = [0.45, 0.45, 0.5]
+        ed.Opacity = 0.07
+        shown = Calculator(Input=threshold(cracks, "time", tp, t1))
+        shown.AttributeType = "Cell Data"
+        shown.ResultArrayName = "after_peak_ms"
+        shown.Function = "(time - %.17g) * 1000" % tp
+        field = "after_peak_ms"
+    cd = Show(shown, view)
+    ColorBy(cd, ("CELLS", field))
+    lut = GetColorTransferFunction(field)
+    if field == "mode":
+        lut.InterpretValuesAsCategories = 1
+        lut.Annotations = ["1", "tension", "2", "shear"]
+        lut.IndexedColors = [0.93, 0.45, 0.0, 0.12, 0.3, 0.85]
+        title = "crack mode"
+    else:
+        lut.ApplyPreset("Viridis (matplotlib)" if field in ("event", "damage") else
+                        "Inferno (matplotlib)", True)
+        lut.RescaleTransferFunction(*((0.0, 1000 * (t1 - tp)) if split else
+                                      series_range(cracks, "CELLS", field, times)))
+        title = {"time": "crack formed at time [s]", "event": "fracture event [-]",
+                 "damage": "contact damage: broken / bonded parts [-]",
+                 "after_peak_ms": "crack formed after the peak [ms]\n(earlier ones: faint grey)"
+                 }[field]
+    legend(view, lut, title, [0.03, 0.08])
+    cd.LineWidth = 3.0
+    try:
+        view.UseDepthPeeling = 1
+    except AttributeError:
+        pass
 
 
 def main(argv):
@@ -139,12 +196,7 @@ def main(argv):
     # Grains: faced cells (3D: the skin, faded) or spheres/disks.
     if cells is not None and not o["grains"]:
         if dim == 3:
-            skin = Threshold(Input=cells)
-            skin.Scalars = ["CELLS", "boundary"]
-            try:
-                skin.LowerThreshold, skin.UpperThreshold = 0.5, 1.5
-            except AttributeError:  # ParaView < 5.10
-                skin.ThresholdRange = [0.5, 1.5]
+            skin = threshold(cells, "boundary", 0.5, 1.5)
             gd = Show(skin, view)
             gd.ColorArrayName = ["POINTS", ""]
             gd.AmbientColor = gd.DiffuseColor = [0.62, 0.62, 0.62]
@@ -173,45 +225,8 @@ def main(argv):
         gd.Opacity = 0.25 if dim == 3 else 1.0
     Hide(grains, view)
 
-    # Cracks, one per broken contact, in a palette the grains do not use.
     if cracks is not None:
-        cd = Show(cracks, view)
-        field = o["color"] if o["color"] != "damage" else "damage"
-        ColorBy(cd, ("CELLS", field))
-        lut = GetColorTransferFunction(field)
-        if field == "mode":
-            lut.InterpretValuesAsCategories = 1
-            lut.Annotations = ["1", "tension", "2", "shear"]
-            lut.IndexedColors = [0.93, 0.45, 0.0, 0.12, 0.3, 0.85]
-            title = "crack mode"
-        else:
-            lut.ApplyPreset("Inferno (matplotlib)" if field == "time" else "Viridis (matplotlib)",
-                            True)
-            lut.RescaleTransferFunction(*series_range(cracks, "CELLS", field, times))
-            title = {"time": "crack formed at time [s]", "event": "fracture event [-]",
-                     "damage": "contact damage: broken / bonded parts [-]"}[field]
-        legend(view, lut, title, [0.03, 0.08])
-        cd.LineWidth = 3.0
-        cd.Opacity = 1.0
-        if times:
-            cracks.UpdatePipeline(times[-1])
-        many = cracks.GetDataInformation().GetNumberOfCells() > 400
-        if field == "time" and dim == 3 and many:
-            # Too many to see through: the early, scattered microcracks faded, the late ones (the
-            # macro-fracture that forms through and after the peak) opaque - the opacity grows
-            # with the time of formation.
-            t0, t1 = series_range(cracks, "CELLS", "time", times)
-            tp = results.get("peak_time_s", 0.5 * (t0 + t1))
-            tp = min(max(tp, t0), t1)
-            if tp >= t1:  # no post-peak part: the last fifth of the cracks' time span
-                tp = t0 + 0.8 * (t1 - t0)
-            pwf = GetOpacityTransferFunction("time")
-            pwf.Points = [t0, 0.08, 0.5, 0.0, tp, 0.3, 0.5, 0.0, t1, 1.0, 0.5, 0.0]
-            lut.EnableOpacityMapping = 1
-            try:
-                view.UseDepthPeeling = 1
-            except AttributeError:
-                pass
+        show_cracks(view, cracks, o["color"], results, times, dim)
 
     if o["walls"]:
         walls = reader("walls")
