@@ -100,6 +100,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     p.vtk = o.boolean("vtk", true);
     p.plots = o.boolean("plots", true);
     p.orientation = o.boolean("orientation", false);
+    p.cells = o.boolean("cells", true);
     p.event_window = o.number("event_window_s", Range::non_negative(), 0.0);
     o.finish();
   }

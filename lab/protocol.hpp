@@ -51,6 +51,7 @@ struct Protocol {
   bool vtk = true;                  ///< write ParaView files
   bool plots = true;                ///< write the SVG stress-strain plot and crack map
   bool orientation = false;         ///< track grain rotation from the loading on (ParaView)
+  bool cells = true;                ///< ParaView: the grains' power cells and crack faces
   double event_window =
       0;                 ///< fracture events: crack time window [s]; 0: 5 grain diameters / P wave
   nlohmann::json raw;    ///< the file as read

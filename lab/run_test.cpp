@@ -296,20 +296,23 @@ void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::t
   nlohmann::json r = f.results();
   const EventClustering ev = fracture_events(f, p, r);
   if (p.vtk) {
-    const CellSummary cells = vtk->write_fractures([&](double t) {
-      Snapshot s;
-      s.dim = f.model().settings.dim;
-      s.outline.round = f.geometry().round || f.geometry().diametral;
-      add_fractures(s, f.cracks().cracks(), ev, t);
-      return s;
-    });
-    r["power_cells"] = {{"grains", cells.grains},
-                        {"hidden_grains", cells.hidden},
-                        {"volume_sum_m3", cells.volume_sum},
-                        {"clip_shape_volume_m3", cells.shape_volume},
-                        {"specimen_volume_m3", f.current_volume()},
-                        {"contact_cracks", cells.contact_cracks},
-                        {"contact_cracks_as_faces", cells.faced_cracks}};
+    const CellSummary cells = vtk->write_fractures(
+        [&](double t) {
+          Snapshot s;
+          s.dim = f.model().settings.dim;
+          s.outline.round = f.geometry().round || f.geometry().diametral;
+          add_fractures(s, f.cracks().cracks(), ev, t);
+          return s;
+        },
+        p.cells);
+    if (p.cells)
+      r["power_cells"] = {{"grains", cells.grains},
+                          {"hidden_grains", cells.hidden},
+                          {"volume_sum_m3", cells.volume_sum},
+                          {"clip_shape_volume_m3", cells.shape_volume},
+                          {"specimen_volume_m3", f.current_volume()},
+                          {"contact_cracks", cells.contact_cracks},
+                          {"contact_cracks_as_faces", cells.faced_cracks}};
     for (const std::string& name : vtk->write_collections())
       sum.files.push_back("vtk/" + name);
   }

@@ -163,7 +163,7 @@ void write_cells(const std::vector<PowerCell>& cells, const FrameGrains& g, cons
 
 } // namespace
 
-CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at) {
+CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at, bool with_cells) {
   std::filesystem::create_directories(dir_);
   std::vector<std::pair<std::string, double>> entries; // tagged first: the summary is the last
   for (const auto& [tag, t] : tagged_)
@@ -193,15 +193,17 @@ CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at
       shape.lo = Vec3(v[1], v[2], v[3]), shape.hi = Vec3(v[4], v[5], v[6]);
       shape.center = Vec3(v[7], v[8], 0), shape.radius = v[9];
     }
-    const std::vector<PowerCell> cells = power_cells(g.info.positions, radius, shape);
-    write_cells(cells, g, s, dir_ / ("cells_" + index + ".vtp"));
+    const std::vector<PowerCell> cells =
+        with_cells ? power_cells(g.info.positions, radius, shape) : std::vector<PowerCell>{};
+    if (with_cells)
+      write_cells(cells, g, s, dir_ / ("cells_" + index + ".vtp"));
     // each contact crack as its grains' shared face, where their cells touch
     std::vector<std::vector<Vec3>> faces(s.contact_cracks.size());
     std::size_t faced = 0;
     for (std::size_t k = 0; k < s.contact_cracks.size() && k < s.contact_crack_grains.size(); ++k) {
       const auto a = g.index.find(s.contact_crack_grains[k][0]);
       const auto b = g.index.find(s.contact_crack_grains[k][1]);
-      if (a == g.index.end() || b == g.index.end())
+      if (a == g.index.end() || b == g.index.end() || cells.empty())
         continue;
       if (const auto* f = cells[static_cast<std::size_t>(a->second)].face_with(b->second)) {
         faces[k] = *f;
@@ -214,11 +216,12 @@ CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at
     sum.grains = cells.size();
     for (const PowerCell& c : cells)
       sum.volume_sum += c.volume, sum.hidden += c.faces.empty();
-    sum.shape_volume = shape.volume();
+    sum.shape_volume = with_cells ? shape.volume() : 0.0;
     sum.faced_cracks = faced;
     sum.contact_cracks = s.contact_cracks.size();
   }
   fractures_ = true;
+  cells_ = with_cells;
   return sum;
 }
 

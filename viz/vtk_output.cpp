@@ -283,8 +283,10 @@ std::vector<std::string> VtkSeries::write(const Snapshot& s, const std::string& 
 std::vector<std::string> VtkSeries::write_collections() const {
   std::vector<std::string> out;
   std::vector<const char*> all = {"grains", "bonds", "cracks", "walls"};
+  if (fractures_ && cells_)
+    all.push_back("cells");
   if (fractures_)
-    all.insert(all.end(), {"cells", "contact_cracks", "events"});
+    all.insert(all.end(), {"contact_cracks", "events"});
   for (const char* series : all) {
     const char* ext = std::string(series) == "grains" ? "vtu" : "vtp";
     std::string text = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" "

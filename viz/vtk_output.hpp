@@ -118,8 +118,9 @@ public:
   /// from the grains file), the per-contact cracks as the faces their grains' cells share
   /// (contact_cracks_*.vtp; a disk where the cells do not touch) and the fracture events
   /// (events_*.vtp) as of its time (`at(time)` gives a Snapshot with contact_cracks, their
-  /// grains, events and round). Returns what the last frame's cells measured.
-  CellSummary write_fractures(const std::function<Snapshot(double)>& at);
+  /// grains, events and round). Returns what the last frame's cells measured. Without
+  /// `with_cells` no cells are made and the contact cracks are disks.
+  CellSummary write_fractures(const std::function<Snapshot(double)>& at, bool with_cells = true);
   /// Write the .pvd collections (time = model time); returns their names.
   std::vector<std::string> write_collections() const;
   int count() const { return static_cast<int>(times_.size()); }
@@ -134,7 +135,7 @@ private:
   std::filesystem::path dir_;
   std::vector<double> times_;
   std::map<std::string, double> tagged_;
-  bool fractures_ = false;
+  bool fractures_ = false, cells_ = false;
 };
 
 /// Number of points, cells and the names of the point/cell arrays of a VTK XML file, read back
