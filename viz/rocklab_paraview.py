@@ -281,7 +281,11 @@ def frame_specimen(view, source, t, dim):
         view.CameraPosition = [cx, cy, cz + 4 * span]
         view.CameraViewUp = [0, 1, 0]
         view.CameraParallelProjection = 1
-        view.CameraParallelScale = 0.58 * max(b[1] - b[0], b[3] - b[2])
+        Render(view)  # the first render resets the camera; set the scale after it
+        h = max(b[3] - b[2], 0.8 * (b[1] - b[0]))
+        cam.SetFocalPoint(cx, cy + 0.05 * h, cz)  # the specimen a little low: the caption above
+        cam.SetPosition(cx, cy + 0.05 * h, cz + 4 * span)
+        cam.SetParallelScale(0.6 * h)
     else:  # an oblique view from the side, z (the loading axis) up
         view.CameraPosition = [cx + 2.2 * span, cy - 1.6 * span, cz + 0.5 * span]
         view.CameraViewUp = [0, 0, 1]
