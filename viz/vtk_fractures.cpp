@@ -165,16 +165,8 @@ void write_cells(const std::vector<PowerCell>& cells, const FrameGrains& g, cons
 
 CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at, bool with_cells) {
   std::filesystem::create_directories(dir_);
-  std::vector<std::pair<std::string, double>> entries; // tagged first: the summary is the last
-  for (const auto& [tag, t] : tagged_)
-    entries.emplace_back(tag, t);
-  for (std::size_t i = 0; i < times_.size(); ++i) {
-    char index[32];
-    std::snprintf(index, sizeof index, "%04zu", i);
-    entries.emplace_back(index, times_[i]);
-  }
   CellSummary sum;
-  for (const auto& [index, t] : entries) {
+  for (const auto& [index, t] : snapshot_files()) {
     Snapshot s = at(t);
     const FrameGrains g = read_grains(dir_ / ("grains_" + index + ".vtu"));
     s.step = static_cast<std::int64_t>(
@@ -212,6 +204,8 @@ CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at
     }
     write_cracks(s.contact_cracks, s, true, dir_ / ("contact_cracks_" + index + ".vtp"), &faces);
     write_events(s.events, s, dir_ / ("events_" + index + ".vtp"));
+    if (tagged_.contains(index))
+      continue; // the summary is of the last numbered snapshot (the end of the test)
     sum = {};
     sum.grains = cells.size();
     for (const PowerCell& c : cells)

@@ -280,6 +280,18 @@ std::vector<std::string> VtkSeries::write(const Snapshot& s, const std::string& 
   return names;
 }
 
+std::vector<std::pair<std::string, double>> VtkSeries::snapshot_files() const {
+  std::vector<std::pair<std::string, double>> files;
+  for (std::size_t i = 0; i < times_.size(); ++i) {
+    char index[32];
+    std::snprintf(index, sizeof index, "%04zu", i);
+    files.emplace_back(index, times_[i]);
+  }
+  for (const auto& [tag, t] : tagged_)
+    files.emplace_back(tag, t);
+  return files;
+}
+
 std::vector<std::string> VtkSeries::write_collections() const {
   std::vector<std::string> out;
   std::vector<const char*> all = {"grains", "bonds", "cracks", "walls"};
@@ -294,13 +306,8 @@ std::vector<std::string> VtkSeries::write_collections() const {
     // Numbered and tagged snapshots in time order (a tag goes before a numbered file of the
     // same time).
     std::vector<std::pair<double, std::string>> entries;
-    for (std::size_t i = 0; i < times_.size(); ++i) {
-      char index[32];
-      std::snprintf(index, sizeof index, "%04zu", i);
-      entries.emplace_back(times_[i], index);
-    }
-    for (const auto& [tag, t] : tagged_)
-      entries.emplace_back(t, tag);
+    for (const auto& [index, t] : snapshot_files())
+      entries.emplace_back(t, index);
     std::stable_sort(entries.begin(), entries.end(),
                      [](const auto& a, const auto& b) { return a.first < b.first; });
     for (const auto& [t, index] : entries) {

@@ -136,6 +136,8 @@ private:
   std::vector<double> times_;
   std::map<std::string, double> tagged_;
   bool fractures_ = false, cells_ = false;
+  /// (file index, time) of every snapshot written: the numbered ones in order, then the tagged.
+  std::vector<std::pair<std::string, double>> snapshot_files() const;
 };
 
 /// Number of points, cells and the names of the point/cell arrays of a VTK XML file, read back
