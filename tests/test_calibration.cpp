@@ -430,6 +430,21 @@ TEST(CalibrationCli, TinyCalibrationMeetsItsTargetsAndResumesFromItsCache) {
       << msg;
   EXPECT_NE(msg.find("(0 suites run"), std::string::npos) << msg;
   EXPECT_EQ(nlohmann::json::parse(rocklab::test::read_file(dir / "out" / "card.json")), card);
+  // A replicate whose test rejected its input (exit 2: it stopped the campaign, e.g. a packing
+  // cache an older rocklab could not read back) is run again on resume, not replayed as a failure.
+  const fs::path first = fs::directory_iterator(dir / "out" / "evaluations")->path();
+  nlohmann::json sm =
+      nlohmann::json::parse(rocklab::test::read_file(first / "suite" / "summary.json"));
+  sm["tests"][0]["status"] = "failed";
+  sm["tests"][0]["exit_status"] = 2;
+  sm["tests"][0]["error"] = "rocklab: input error: an old rejection";
+  std::ofstream(first / "suite" / "summary.json") << sm.dump(2);
+  ASSERT_EQ(rocklab::test::run_command(
+                rocklab::test::binary() + " calibrate " + file + " -o " + out + " --jobs 1", &msg),
+            0)
+      << msg;
+  EXPECT_NE(msg.find("(1 suites run"), std::string::npos) << msg;
+  EXPECT_EQ(nlohmann::json::parse(rocklab::test::read_file(dir / "out" / "card.json")), card);
   ASSERT_EQ(rocklab::test::run_command(rocklab::test::binary() + " genesis " + out +
                                        "/card.json -o " + out + "/fitted.rlspec -q"),
             0);

@@ -51,6 +51,7 @@ void Evaluator::run_suites(const nlohmann::json& card, const std::vector<const R
         write_text_file(r.dir / "suite.json", suite.dump(2) + "\n");
         SuiteOptions so;
         so.out_dir = (r.dir / "suite").string();
+        fs::remove_all(so.out_dir); // a rejected earlier attempt's files
         so.executable = o_.executable;
         so.threads = std::max(1, cores / jobs);
         so.interrupt = o_.interrupt;
@@ -93,6 +94,27 @@ void Evaluator::check_tests(const nlohmann::json& summary, const fs::path& suite
   }
 }
 
+namespace {
+// A finished replicate is reused unless one of its tests rejected its input (exit status 2). That
+// rejection stopped the campaign; once its cause is fixed (in the file, or in rocklab: a 3D packing
+// cache that could not be read back) a resumed campaign runs the replicate again instead of
+// stopping on the old verdict.
+bool reusable(const fs::path& suite_out) {
+  const fs::path f = suite_out / "summary.json";
+  if (!fs::exists(f))
+    return false;
+  try {
+    const nlohmann::json sm = read_json_file(f.string(), Nulls::Allow);
+    for (const auto& t : sm.value("tests", nlohmann::json::array()))
+      if (t.value("exit_status", 0) == 2)
+        return false;
+  } catch (const std::exception&) {
+    return false; // unreadable: run it again
+  }
+  return true;
+}
+} // namespace
+
 Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_t seeds) {
   const nlohmann::json card = apply_params(c_.material, c_.params, values);
   const nlohmann::json stage_tests = tests_of(s);
@@ -120,7 +142,7 @@ Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_
   // list; this rank runs every size-th of the missing ones.
   std::string missing;
   for (const Replicate& r : reps)
-    missing += fs::exists(r.dir / "suite" / "summary.json") ? '0' : '1';
+    missing += reusable(r.dir / "suite") ? '0' : '1';
   const Ranks* ranks = o_.ranks;
   if (ranks)
     missing = ranks->broadcast(missing);

@@ -250,9 +250,12 @@ std::string Model::check_loaded() const {
     const bool facet = c.kind == ContactKind::BallFacet;
     if (!in(c.end1, n) || (!facet && !in(c.end2, n)) || (facet && !in(c.end2, walls.size())))
       return "contact " + std::to_string(k) + ": end out of range";
-    if (facet && c.facet != -1 &&
-        !in(c.facet, walls[static_cast<std::size_t>(c.end2)].facets.size()))
-      return "contact " + std::to_string(k) + ": facet out of range";
+    if (facet && c.facet != -1) {
+      const Wall& w = walls[static_cast<std::size_t>(c.end2)];
+      // An exact cylinder is one surface: its contacts carry facet 0 (Wall::closest_point).
+      if (!in(c.facet, w.is_cylinder() ? std::size_t{1} : w.facets.size()))
+        return "contact " + std::to_string(k) + ": facet out of range";
+    }
     if (!in(c.slot, slots[static_cast<std::size_t>(c.model)]))
       return "contact " + std::to_string(k) + ": model slot out of range";
     if (c.key != contact_key(c.kind, c.end1, c.end2))
