@@ -119,6 +119,51 @@ TEST(Calibration, ScatterInPoissonsRatioDoesNotThrowTheStiffnessRatioAcrossItsRa
   EXPECT_GT(kr[2] / kr[1], 1.0); // still towards the target
 }
 
+TEST(Calibration, AnInertShapeParameterIsNamedAndAloneStopsTheStage) {
+  // A rock whose joints all break in tension: the cohesion/tension ratio moves nothing. A stage 3
+  // with only that parameter free once spent its whole budget (COBYLA, 20 evaluations of 10
+  // minutes); it now stops after the step that shows it inert and says so.
+  std::mt19937 rng_truth(1);
+  const Measured want = synthetic_rock({6e10, 2.5, 2e7, 8.0, 0.2}, 0.0, rng_truth);
+  // UCS/BTS out of the ratio's reach (it does not act) and of the slits' (not free here).
+  const std::vector<Target> targets{{kUcs, want.at(kUcs), 0.05},
+                                    {"ucs_over_bts", 1.3 * want.at("ucs_over_bts"), 0.10}};
+  int ratio_calls = 0;
+  auto inert_r = [&](std::vector<double> v, Stage s) {
+    ratio_calls += s == Stage::Ratios;
+    v.resize(5, 0.4); // no slit parameter: the fraction stays 2x off
+    v[3] = 8.0;       // the ratio does not act
+    std::mt19937 rng(2);
+    return synthetic_rock(v, 0.0, rng);
+  };
+  std::vector<Param> one = synthetic_params(6e10, 2.5, 2e7);
+  one.pop_back();
+  const Outcome a = calibrate(one, targets, inert_r, Budget{});
+  EXPECT_EQ(ratio_calls, 2);
+  ASSERT_EQ(a.notes.size(), 2u);
+  EXPECT_NE(a.notes[0].find("coh_over_ten moved from 16 to"), std::string::npos) << a.notes[0];
+  EXPECT_NE(a.notes[0].find("inert"), std::string::npos) << a.notes[0];
+  EXPECT_NE(a.notes[1].find("every shape parameter is inert"), std::string::npos);
+  // With the slit fraction free as well, the inert ratio is named and the search goes on with the
+  // slits, which meet the target.
+  ratio_calls = 0;
+  auto inert_r_slit = [&](std::vector<double> v, Stage) {
+    v[3] = 8.0;
+    std::mt19937 rng(2);
+    return synthetic_rock(v, 0.0, rng);
+  };
+  const std::vector<Target> reachable{
+      {kUcs, want.at(kUcs), 0.05},
+      {"ucs_over_bts", want.at("ucs_over_bts"), 0.10},
+      {"crack_initiation_over_ucs", want.at("crack_initiation_over_ucs"), 0.05, true}};
+  const Outcome b = calibrate(synthetic_params(6e10, 2.5, 2e7), reachable, inert_r_slit, Budget{});
+  ASSERT_FALSE(b.notes.empty());
+  EXPECT_NE(b.notes[0].find("coh_over_ten"), std::string::npos) << b.notes[0];
+  for (const std::string& n : b.notes)
+    EXPECT_EQ(n.find("slit"), std::string::npos) << n;
+  EXPECT_TRUE(b.met);
+}
+
 TEST(Calibration, ASeedWithoutAMeasurementDoesNotBlankTheEvaluation) {
   // A Brazilian disk that never split on one seed: its BTS is null there.
   const std::map<std::string, std::vector<double>> all{

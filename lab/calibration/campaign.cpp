@@ -104,6 +104,9 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   };
   CampaignSummary cs;
   cs.outcome = calibrate(params, c.targets, evaluate, c.budget);
+  if (o.progress && (!o.ranks || o.ranks->root()))
+    for (const std::string& n : cs.outcome.notes)
+      std::fprintf(stderr, "[rocklab calibrate] note: %s\n", n.c_str());
   ReportInput r;
   r.file = &c;
   r.outcome = &cs.outcome;

@@ -152,6 +152,11 @@ std::string report_md(const ReportInput& r) {
                   " replicate seed(s) per evaluation.\n\n";
   s += std::string("**") + (out.met ? "Every target met." : "Not every target met.") + "**\n\n";
   s += targets_table(r) + "\n" + params_table(r) + "\n" + sensitivity_table(r);
+  if (!out.notes.empty()) {
+    s += "\n**Noticed on the way:**\n\n";
+    for (const std::string& n : out.notes)
+      s += "- " + n + "\n";
+  }
   s += "\n**Cost:** " + std::to_string(out.history.size()) + " evaluations; " +
        std::to_string(r.suites_run) + " suites run, " + std::to_string(r.suites_cached) +
        " from the cache; " + fmt(r.wall_seconds, "%.0f") + " s wall time, " +

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <limits>
 
@@ -51,6 +52,62 @@ const char* role_name(Role r) {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
+// A shape parameter's search coordinate in [0, 1] (logarithmic for positive bounds) and back.
+double to_unit(const Param& q) {
+  return q.lo > 0 ? std::log(q.value / q.lo) / std::log(q.hi / q.lo)
+                  : (q.value - q.lo) / (q.hi - q.lo);
+}
+double from_unit(const Param& q, double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return q.lo > 0 ? q.lo * std::pow(q.hi / q.lo, x) : q.lo + x * (q.hi - q.lo);
+}
+
+// Inert shape parameters: a step of one shape parameter alone (BOBYQA's first points are such
+// steps) that moves no scale-free target by a tenth of its tolerance. In the 2D granite and the 3D
+// Berea the cohesion/tension ratio was (every joint breaks in tension), and COBYLA spent its
+// budget on it; once every shape parameter has proved inert the stage stops.
+struct InertWatch {
+  std::vector<int> state; ///< per shape parameter: 0 unknown, 1 inert, 2 moves a target
+  std::vector<double> prev_x, prev_e;
+
+  explicit InertWatch(std::size_t n) : state(n, 0) {}
+  /// After an evaluation at x (search coordinates) with these target errors (in tolerances).
+  void step(const std::vector<double>& x, const std::vector<double>& e, const std::vector<Param>& p,
+            const std::vector<std::size_t>& shape, std::vector<std::string>& notes) {
+    if (!prev_x.empty()) {
+      std::vector<std::size_t> moved;
+      for (std::size_t k = 0; k < x.size(); ++k)
+        if (std::abs(x[k] - prev_x[k]) >= 0.05)
+          moved.push_back(k);
+      double change = 0;
+      for (std::size_t i = 0; i < e.size(); ++i)
+        change = std::max(change, std::isfinite(e[i]) && std::isfinite(prev_e[i])
+                                      ? std::abs(e[i] - prev_e[i])
+                                      : kInf);
+      if (moved.size() == 1 && state[moved[0]] != 2) {
+        const Param& q = p[shape[moved[0]]];
+        state[moved[0]] = change < 0.1 ? 1 : 2;
+        if (change < 0.1)
+          notes.push_back(q.name + " moved from " + num(from_unit(q, prev_x[moved[0]])) + " to " +
+                          num(q.value) +
+                          " and no scale-free target by a tenth of its tolerance (largest " +
+                          num(change) + "): inert for these targets; free another parameter");
+      }
+    }
+    prev_x = x;
+    prev_e = e;
+  }
+  bool all_inert() const {
+    return std::all_of(state.begin(), state.end(), [](int v) { return v == 1; });
+  }
+};
 
 bool is_stress(const std::string& property) {
   return property.size() > 3 && property.ends_with("_Pa") && property != kYoungs;
@@ -175,27 +232,25 @@ void Campaign::ratios(int budget) {
       free.push_back(&t);
   if (shape.empty() || free.empty() || budget < 1)
     return;
-  auto to_x = [&](const Param& q) {
-    return q.lo > 0 ? std::log(q.value / q.lo) / std::log(q.hi / q.lo)
-                    : (q.value - q.lo) / (q.hi - q.lo);
-  };
-  auto from_x = [&](const Param& q, double x) {
-    x = std::clamp(x, 0.0, 1.0);
-    return q.lo > 0 ? q.lo * std::pow(q.hi / q.lo, x) : q.lo + x * (q.hi - q.lo);
+  // Each scale-free target's error in tolerances (a stress X as X / UCS).
+  auto errors = [&](const Measured& m) {
+    std::vector<double> e;
+    const double u = value_of(m, kUcs);
+    for (const Target* t : free) {
+      if (is_stress(t->property)) {
+        Target r = *t;
+        r.value = t->value / tu->value;
+        e.push_back(r.error(value_of(m, t->property) / u));
+      } else {
+        e.push_back(t->error(value_of(m, t->property)));
+      }
+    }
+    return e;
   };
   auto misfit = [&](const Measured& m, double& worst) {
     double sum = 0;
     worst = 0;
-    const double u = value_of(m, kUcs);
-    for (const Target* t : free) {
-      double e;
-      if (is_stress(t->property)) {
-        Target r = *t;
-        r.value = t->value / tu->value;
-        e = r.error(value_of(m, t->property) / u);
-      } else {
-        e = t->error(value_of(m, t->property));
-      }
+    for (double e : errors(m)) {
       sum += std::isfinite(e) ? e * e : 1e6;
       worst = std::max(worst, std::abs(e));
     }
@@ -205,6 +260,7 @@ void Campaign::ratios(int budget) {
   std::vector<double> best_values;
   int used = 0;
   const std::size_t n = shape.size();
+  InertWatch inert(n);
   nlopt::opt opt(n == 1 ? nlopt::LN_COBYLA : nlopt::LN_BOBYQA, static_cast<unsigned>(n));
   opt.set_lower_bounds(std::vector<double>(n, 0.0));
   opt.set_upper_bounds(std::vector<double>(n, 1.0));
@@ -216,7 +272,7 @@ void Campaign::ratios(int budget) {
   std::exception_ptr thrown;
   auto objective = [&](const std::vector<double>& x) {
     for (std::size_t k = 0; k < n; ++k)
-      p[shape[k]].value = from_x(p[shape[k]], x[k]);
+      p[shape[k]].value = from_unit(p[shape[k]], x[k]);
     Measured m;
     try {
       m = run(Stage::Ratios);
@@ -228,13 +284,17 @@ void Campaign::ratios(int budget) {
     ++used;
     double worst;
     const double f = misfit(m, worst);
+    inert.step(x, errors(m), p, shape, out.notes);
     if (f < best) {
       best = f;
       best_values.clear();
       for (const Param& q : p)
         best_values.push_back(q.value);
     }
-    if (worst <= 1 || used >= budget)
+    const bool all_inert = inert.all_inert();
+    if (all_inert)
+      out.notes.push_back("stage 3 stopped: every shape parameter is inert");
+    if (worst <= 1 || used >= budget || all_inert)
       opt.force_stop();
     return f;
   };
@@ -244,7 +304,7 @@ void Campaign::ratios(int budget) {
                         &objective);
   std::vector<double> x(n);
   for (std::size_t k = 0; k < n; ++k)
-    x[k] = to_x(p[shape[k]]);
+    x[k] = to_unit(p[shape[k]]);
   double f = 0;
   try {
     opt.optimize(x, f);

@@ -68,6 +68,9 @@ struct Outcome {
   Measured measured;         ///< at the final values (the last full evaluation)
   std::vector<Record> history;
   bool met = false; ///< every target within its tolerance
+  /// What the method noticed on the way, for the report: e.g. a shape parameter that moved no
+  /// steered property (inert for these targets: another parameter should be freed).
+  std::vector<std::string> notes;
 };
 
 /// Evaluations per stage at most; polish: each of stages 1 and 2 again after stage 3. The
