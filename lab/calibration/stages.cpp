@@ -247,10 +247,10 @@ void Campaign::ratios(int budget) {
     }
     return e;
   };
-  auto misfit = [&](const Measured& m, double& worst) {
+  auto misfit = [](const std::vector<double>& errs, double& worst) {
     double sum = 0;
     worst = 0;
-    for (double e : errors(m)) {
+    for (double e : errs) {
       sum += std::isfinite(e) ? e * e : 1e6;
       worst = std::max(worst, std::abs(e));
     }
@@ -282,9 +282,10 @@ void Campaign::ratios(int budget) {
       return HUGE_VAL;
     }
     ++used;
+    const std::vector<double> errs = errors(m);
     double worst;
-    const double f = misfit(m, worst);
-    inert.step(x, errors(m), p, shape, out.notes);
+    const double f = misfit(errs, worst);
+    inert.step(x, errs, p, shape, out.notes);
     if (f < best) {
       best = f;
       best_values.clear();
