@@ -319,8 +319,8 @@ void FlatJoint::update(Contact& c, Elements e, const ContactKinematics& k, Conta
   bool any_bonded = false;
   for (const auto& el : e)
     any_bonded = any_bonded || el.B == BondState::Bonded;
-  const double min_gap = c.gs - R * std::hypot(c.tbs, c.tbt);
-  if (!any_bonded && min_gap >= 0) {
+  // The smallest gap over the interface (only read without bonds: hypot is a costly libm call).
+  if (!any_bonded && c.gs - R * std::hypot(c.tbs, c.tbt) >= 0) {
     for (auto& el : e) {
       if (el.slip)
         events.slip_change(false, static_cast<std::int32_t>(&el - e.data()) + 1);
