@@ -164,6 +164,42 @@ TEST(Calibration, AnInertShapeParameterIsNamedAndAloneStopsTheStage) {
   EXPECT_TRUE(b.met);
 }
 
+TEST(Calibration, StageThreeKeepsThePointThatMeetsEveryTargetOverACloserMiss) {
+  // As in the Berea campaign: stage 3's second point misses the BTS target with the smallest sum
+  // of squared errors (0.06, -1.18 tolerances), its third meets both (-0.8, -0.92). The stage
+  // stops at the third and must hand that one to the polish.
+  const std::vector<Target> targets{{kYoungs, 1.6e10, 0.05},
+                                    {kPoisson, 0.28, 0.03, true},
+                                    {kUcs, 4e7, 0.05},
+                                    {"bts_Pa", 4e6, 0.25}};
+  const std::vector<std::pair<double, double>> stage3{// (nu, BTS) of each stage-3 point
+                                                      {0.28, 2.6e6},
+                                                      {0.2818, 2.82e6},
+                                                      {0.256, 3.08e6}};
+  std::vector<std::vector<double>> asked;
+  double bts_now = 2.6e6;
+  auto rock = [&](const std::vector<double>& v, Stage s) {
+    Measured m{{kYoungs, 1.6e10}, {kPoisson, 0.28}, {kUcs, 4e7}, {"bts_Pa", bts_now}};
+    if (s == Stage::Ratios) {
+      const std::size_t k = std::min(asked.size(), stage3.size() - 1);
+      asked.push_back(v);
+      m[kPoisson] = stage3[k].first;
+      m["bts_Pa"] = bts_now = stage3[k].second;
+    }
+    return m;
+  };
+  const std::vector<Param> params{{"emod", Role::Modulus, 1e9, 1e12, 5e10},
+                                  {"kratio", Role::StiffnessRatio, 1.0, 20.0, 14.0},
+                                  {"ten", Role::Strength, 1e6, 1e9, 4e7},
+                                  {"gapped", Role::Shape, 0.0, 0.45, 0.1},
+                                  {"slit", Role::Shape, 0.0, 0.45, 0.1}};
+  const Outcome out = calibrate(params, targets, rock, Budget{});
+  ASSERT_EQ(asked.size(), 3u); // stopped at the point that met both
+  EXPECT_NE(asked[1], asked[2]);
+  EXPECT_EQ(out.params[3].value, asked[2][3]);
+  EXPECT_EQ(out.params[4].value, asked[2][4]);
+}
+
 TEST(Calibration, ASeedWithoutAMeasurementDoesNotBlankTheEvaluation) {
   // A Brazilian disk that never split on one seed: its BTS is null there.
   const std::map<std::string, std::vector<double>> all{

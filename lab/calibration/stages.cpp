@@ -216,10 +216,30 @@ void Campaign::strength(int budget) {
   }
 }
 
+// Stage 3's best evaluated point. One that meets every scale-free target (where the search stops)
+// beats one with a smaller sum of squared errors that misses one: the Berea campaign kept a point
+// with errors (0.06, -1.18) over the one with (-0.8, -0.92) that met both, and polished the wrong
+// card.
+struct BestPoint {
+  double f = kInf; ///< sum of squared errors [tolerances^2]
+  bool met = false;
+  std::vector<double> values;
+  void offer(double f_new, bool met_new, const std::vector<Param>& p) {
+    if (!((met_new && !met) || (met_new == met && f_new < f)))
+      return;
+    f = f_new;
+    met = met_new;
+    values.clear();
+    for (const Param& q : p)
+      values.push_back(q.value);
+  }
+};
+
 // Stage 3: the scale-free targets (every target but E and the UCS; a stress target X becomes
 // X / UCS against its target / the UCS target) by BOBYQA over the shape parameters, in [0, 1]
 // coordinates (logarithmic for positive bounds). The best evaluated point is kept, never a model
-// prediction; the search stops early once every scale-free target is met.
+// prediction: the first that meets every scale-free target (the search stops there), else the
+// smallest sum of squared errors.
 void Campaign::ratios(int budget) {
   std::vector<std::size_t> shape;
   for (std::size_t i = 0; i < p.size(); ++i)
@@ -256,8 +276,7 @@ void Campaign::ratios(int budget) {
     }
     return sum;
   };
-  double best = kInf;
-  std::vector<double> best_values;
+  BestPoint best;
   int used = 0;
   const std::size_t n = shape.size();
   InertWatch inert(n);
@@ -286,12 +305,7 @@ void Campaign::ratios(int budget) {
     double worst;
     const double f = misfit(errs, worst);
     inert.step(x, errs, p, shape, out.notes);
-    if (f < best) {
-      best = f;
-      best_values.clear();
-      for (const Param& q : p)
-        best_values.push_back(q.value);
-    }
+    best.offer(f, worst <= 1, p);
     const bool all_inert = inert.all_inert();
     if (all_inert)
       out.notes.push_back("stage 3 stopped: every shape parameter is inert");
@@ -315,8 +329,8 @@ void Campaign::ratios(int budget) {
   }
   if (thrown)
     std::rethrow_exception(thrown);
-  for (std::size_t i = 0; i < p.size() && best_values.size() == p.size(); ++i)
-    p[i].value = best_values[i];
+  for (std::size_t i = 0; i < p.size() && best.values.size() == p.size(); ++i)
+    p[i].value = best.values[i];
 }
 
 } // namespace
