@@ -76,6 +76,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
       p.jaw_radius_ratio = l.number("jaw_radius_ratio", Range::closed(1.1, 10), 1.5);
     else if (l.has("jaw_radius_ratio"))
       l.fail("jaw_radius_ratio", "applies to \"jaws\": \"curved\" only");
+    p.density_scaling = l.number("density_scaling", Range::half_open(0, 1), 0.0);
     test->check_loading(l, p);
     l.finish();
   }

@@ -36,6 +36,9 @@ struct Protocol {
   double reverse_at_strain = 0; ///< > 0: unload from this axial strain back to zero (elastic test)
   /// Brazilian: 0 flat platens; > 0 curved jaws (ISRM 1978) of this times the disk's radius.
   double jaw_radius_ratio = 0;
+  /// > 0: density scaling from the start of loading, the time step raised to this quantile of
+  /// the grains' own stable steps (Model::scale_density); 0: off.
+  double density_scaling = 0;
   // stop
   double post_peak_fraction = 0.9; ///< stop when the load falls to this fraction of its peak
   std::int64_t min_steps = 1000;   ///< ... but not before this many loading steps

@@ -835,7 +835,9 @@ TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
       {{{"test", "brazilian"},
         {"specimen", {{"file", spec}}},
         {"loading", {{"jaw_radius_ratio", 2.0}}}},
-       "applies to \"jaws\": \"curved\" only"}};
+       "applies to \"jaws\": \"curved\" only"},
+      {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"density_scaling", 1.0}}}},
+       "key 'loading.density_scaling': value 1.0 is out of range [0, 1)"}};
   for (const Case& k : cases) {
     const std::string file = protocol("bad", k.j);
     const fs::path out = scratch("bad_out");
@@ -873,8 +875,11 @@ TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
 
 TEST(Lab, CheckpointResumeIsByteIdenticalAndSigintLeavesACheckpointOrNothing) {
   const std::string spec = specimen("lab_2d_fj");
-  const std::string file = protocol(
-      "cp", {{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"strain_rate", 0.2}}}});
+  const std::string file =
+      protocol("cp", {{"test", "ucs"},
+                      {"specimen", {{"file", spec}}},
+                      // density scaling too: its factors travel in the checkpoint
+                      {"loading", {{"strain_rate", 0.2}, {"density_scaling", 0.25}}}});
   const fs::path full = scratch("cp_full");
   std::string msg;
   ASSERT_EQ(test::run_command(test::binary() + " test " + file + " -o " + full.string() +

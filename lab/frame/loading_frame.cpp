@@ -84,6 +84,8 @@ const char* LoadingFrame::phase_name() const {
 }
 
 void LoadingFrame::begin_loading() {
+  if (p_.density_scaling > 0)
+    density_ = m_.scale_density(p_.density_scaling);
   phase_ = kLoad;
   load_start_step_ = phase_start_step_ = ramp_start_step_ = m_.step();
   energy_load_ = ledger_values(m_.energy());
@@ -310,6 +312,8 @@ template <class A> void LoadingFrame::fields(A& a) {
   a("shell", shell_), a("v_final", v_final_), a("sep_ref", sep_ref_), a("shell_ref", shell_ref_);
   a("lateral_ref", lateral_ref_), a("load_ref", load_ref_), a("reference", reference_);
   a.object("peak", peak_);
+  if (p_.density_scaling > 0) // (checkpoints of runs without it keep their old fields)
+    a.object("density_scaling", density_);
   a.object("confinement_band", band_);
   a("servo_integral", servo_integral_), a("bond_break_events", bond_break_events_);
   a("next_snapshot_strain", next_snapshot_strain_), a("snapshot_due", snapshot_due_);
@@ -443,10 +447,20 @@ nlohmann::json LoadingFrame::results() const {
                  {"density_per_m3", static_cast<double>(monitor_.total()) / geo_.volume},
                  {"area_per_volume_per_m", crack_area / geo_.volume}};
   r["bond_break_events"] = bond_break_events_;
+  r["load_start_step"] = load_start_step_;
   r["peak_step"] = peak_.step;
   r["peak_time_s"] = peak_.time;
   r["loading_rate"] = {{"platen_velocity_m_per_s", v_final_},
                        {"strain_rate_per_s", 2 * v_final_ / geo_.loaded_length()}};
+  if (p_.density_scaling > 0)
+    r["density_scaling"] = {
+        {"quantile", density_.quantile},
+        {"timestep_gain", density_.step_gain},
+        {"scaled_grains", density_.scaled},
+        {"max_inertia_factor", density_.max_factor},
+        {"method", "from the start of loading, the grains whose own stable step was below the "
+                   "quantile's got the inertial mass and moment of inertia for that step (gravity "
+                   "and outputs keep the true masses)"}};
   test_.results(*this, r);
   energy_results(r);
   quasi_static_results(r);

@@ -232,6 +232,7 @@ private:
   double load_ref_ = 0;             ///< load when loading began (the seating stress)
   std::vector<Vec3> reference_;     ///< grain positions when the test began
   PeakRecord peak_;
+  DensityScaling density_; ///< what the density scaling did at the start of loading
   ConfinementBand band_;
   std::vector<double> servo_integral_; ///< sum of the confinement error of each wall [Pa]
   // per-step servo sums by wall index (derived each step, reused buffers)

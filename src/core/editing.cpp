@@ -220,6 +220,8 @@ void Model::remove_balls(const std::vector<bool>& remove) {
   compact(balls.damping_work);
   if (balls.tracks_orientation())
     compact(balls.orient);
+  mass_scale_.clear(); // density scaling ends with a change of the balls
+  inertia_scale_.clear();
   // Clumps go whole or stay whole; the work of what goes stays in the group totals.
   std::vector<Clump> kept_clumps;
   for (Clump& c : clumps) {

@@ -62,8 +62,8 @@ std::vector<EnergyLedger> Model::group_energy() const {
     if (balls.clump[i] >= 0)
       continue;
     EnergyLedger& l = at(balls.group[i]);
-    l.kinetic_translational += 0.5 * balls.mass[i] * balls.vel[i].squaredNorm(); // Eq. 4
-    l.kinetic_rotational += 0.5 * balls.inertia[i] * balls.spin[i].squaredNorm();
+    l.kinetic_translational += 0.5 * inertial_mass(i) * balls.vel[i].squaredNorm(); // Eq. 4
+    l.kinetic_rotational += 0.5 * inertial_inertia(i) * balls.spin[i].squaredNorm();
     l.body_work += balls.body_work[i];
     l.gravity_work += balls.gravity_work[i];
     l.local_damping += balls.damping_work[i];
@@ -86,8 +86,8 @@ EnergyLedger Model::energy() const {
   const auto kin = block_sum<2>(balls.size(), [&](std::size_t i, std::array<double, 2>& acc) {
     if (balls.clump[i] >= 0)
       return; // counted with the clump
-    acc[0] += 0.5 * balls.mass[i] * balls.vel[i].squaredNorm();
-    acc[1] += 0.5 * balls.inertia[i] * balls.spin[i].squaredNorm();
+    acc[0] += 0.5 * inertial_mass(i) * balls.vel[i].squaredNorm();
+    acc[1] += 0.5 * inertial_inertia(i) * balls.spin[i].squaredNorm();
   });
   e.kinetic_translational = kin[0];
   e.kinetic_rotational = kin[1];

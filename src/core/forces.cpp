@@ -56,7 +56,7 @@ bool Model::update_contact_force(std::size_t ci, double dt, EventBuffer& events)
   const double R1 = balls.radius[i1];
   PlaneGeometry g;
   Vec3 xb2, v2, w2;
-  double R2 = 0, m_eff = balls.mass[i1];
+  double R2 = 0, m_eff = inertial_mass(i1);
   if (c.kind == ContactKind::BallBall) {
     const std::size_t i2 = static_cast<std::size_t>(c.end2);
     R2 = balls.radius[i2];
@@ -64,7 +64,8 @@ bool Model::update_contact_force(std::size_t ci, double dt, EventBuffer& events)
     xb2 = balls.pos[i2];
     v2 = balls.vel[i2];
     w2 = balls.spin[i2];
-    m_eff = balls.mass[i1] * balls.mass[i2] / (balls.mass[i1] + balls.mass[i2]);
+    const double m1 = inertial_mass(i1), m2 = inertial_mass(i2);
+    m_eff = m1 * m2 / (m1 + m2);
   } else {
     const Wall& wall = walls[static_cast<std::size_t>(c.end2)];
     g = ball_facet_plane(x1, R1, wall.closest_point(x1, &c.facet));
@@ -171,9 +172,9 @@ double Model::sum_ball_forces() {
     balls.force[i] = F;
     balls.moment[i] = M;
     if (k_tran > 0)
-      dt_min = std::min(dt_min, std::sqrt(balls.mass[i] / k_tran));
+      dt_min = std::min(dt_min, std::sqrt(inertial_mass(i) / k_tran));
     if (k_rot > 0)
-      dt_min = std::min(dt_min, std::sqrt(balls.inertia[i] / k_rot));
+      dt_min = std::min(dt_min, std::sqrt(inertial_inertia(i) / k_rot));
   }
   return dt_min;
 }

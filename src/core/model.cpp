@@ -56,6 +56,10 @@ void Model::cycle(std::int64_t count) {
   if (!initialized_)
     initialize();
   ensure_thread_buffers();
+  if (mass_scale_.size() != balls.size() && !mass_scale_.empty()) { // balls added or removed
+    mass_scale_.clear();
+    inertia_scale_.clear();
+  }
   for (std::int64_t k = 0; k < count; ++k) {
     const double dt = estimate_timestep();
     dt_ = dt;

@@ -38,6 +38,18 @@ struct ModelSettings {
   bool slip_events = true;      ///< record slip_change events (off where nobody reads them)
 };
 
+/// What Model::scale_density did.
+struct DensityScaling {
+  double quantile = 0;    ///< of the balls' own stable steps the step was raised to [-]
+  double step_gain = 1;   ///< stiffness-limited time step after / before [-]
+  std::size_t scaled = 0; ///< balls whose inertial mass or moment of inertia was raised
+  double max_factor = 1;  ///< the largest factor on a mass or moment of inertia [-]
+  template <class A> void fields(A& a) {
+    a("quantile", quantile), a("step_gain", step_gain), a("scaled", scaled);
+    a("max_factor", max_factor);
+  }
+};
+
 /// Which contacts an operation applies to.
 enum class ContactSelect { All, BallBall, BallFacet };
 
@@ -129,6 +141,21 @@ public:
   Eigen::Matrix3d average_stress(double volume) const;
   /// Number of contacts whose model reports them active (carrying load).
   std::size_t active_contact_count() const;
+  /// Density scaling for quasi-static runs (src/core/density_scaling.cpp): every free ball whose
+  /// own stable step (sqrt(m / k_tran), sqrt(I / k_rot) with its contacts' stiffness now) is below
+  /// the `quantile` of all free balls' steps gets the inertial mass and moment of inertia that
+  /// give it that step, so the automatic time step rises to that quantile. Gravity and outputs
+  /// keep the true masses; each ball keeps its kinetic energy (its velocity is scaled), so the
+  /// energy ledger stays closed. quantile 0 (or a change in the number of balls) turns it off.
+  DensityScaling scale_density(double quantile);
+  bool density_scaled() const { return !mass_scale_.empty() && mass_scale_.size() == balls.size(); }
+  /// The mass and moment of inertia the law of motion uses (the true ones without scaling).
+  double inertial_mass(std::size_t i) const {
+    return density_scaled() ? balls.mass[i] * mass_scale_[i] : balls.mass[i];
+  }
+  double inertial_inertia(std::size_t i) const {
+    return density_scaled() ? balls.inertia[i] * inertia_scale_[i] : balls.inertia[i];
+  }
 
   /// Read or write the whole state (archive = specimen/checkpoint reader or writer).
   template <class Archive> void serialize(Archive& a);
@@ -198,6 +225,8 @@ private:
   /// Per group: bond energy released by breaks (in the bond_strain field, see group_energy).
   std::vector<EnergyLedger> broken_;
   std::size_t blowup_contact_ = 0;
+  /// Density scaling: factors (>= 1) on each ball's mass and moment of inertia; empty when off.
+  std::vector<double> mass_scale_, inertia_scale_;
 };
 
 } // namespace rocklab

@@ -94,10 +94,10 @@ void Model::law_of_motion(double dt) {
   auto sums = block_sum<4>(balls.size(), [&](std::size_t i, std::array<double, 4>& acc) {
     if (balls.clump[i] >= 0)
       return; // pebbles move with their clump (move_clumps)
-    const double m = balls.mass[i];
+    const double m = inertial_mass(i);
     double bw = 0, gw = 0, dw = 0; // this ball's body, gravity and damping work
     const std::uint8_t fix = balls.fixity[i];
-    const Vec3 Fg = m * gvec;
+    const Vec3 Fg = balls.mass[i] * gvec; // gravity acts on the true mass
     const Vec3 Fbody = Fg + balls.applied_force[i];
     const Vec3 F = balls.force[i] + Fbody;
     Vec3& v = balls.vel[i];
@@ -115,7 +115,7 @@ void Model::law_of_motion(double dt) {
       bw += Fbody[d] * 0.5 * (v0 + v1) * dt; // Eq. 2
       gw += Fg[d] * 0.5 * (v0 + v1) * dt;    // Eq. 3
     }
-    const double I = balls.inertia[i];
+    const double I = inertial_inertia(i);
     const Vec3 M = balls.moment[i] + balls.applied_moment[i];
     Vec3& w = balls.spin[i];
     for (int d = (dim == 2 ? 2 : 0); d < 3; ++d) {

@@ -201,6 +201,8 @@ template <class A> void Model::serialize(A& a) {
     if (track)
       a.vec(balls.orient, [&](Eigen::Quaterniond& q) { a(q.w()), a(q.x()), a(q.y()), a(q.z()); });
   }
+  if (a.version >= 8) // density scaling of a checkpointed quasi-static test (empty: off)
+    each(a, mass_scale_), each(a, inertia_scale_);
   if constexpr (A::reading) {
     if (outputs_.size() != contacts_.size())
       throw InputError("corrupt specimen body (contact arrays of different lengths)");
@@ -233,6 +235,14 @@ std::string Model::check_loaded() const {
       if (!(std::abs(balls.orient[i].norm() - 1) < 1e-9))
         return "ball " + std::to_string(i) + ": orientation is not a unit quaternion";
   }
+  if (mass_scale_.size() != inertia_scale_.size() ||
+      (!mass_scale_.empty() && mass_scale_.size() != n))
+    return "density scaling for " + std::to_string(mass_scale_.size()) + " of " +
+           std::to_string(n) + " balls";
+  for (std::size_t i = 0; i < mass_scale_.size(); ++i)
+    if (!(mass_scale_[i] >= 1 && inertia_scale_[i] >= 1 && std::isfinite(mass_scale_[i]) &&
+          std::isfinite(inertia_scale_[i])))
+      return "ball " + std::to_string(i) + ": a density-scaling factor is not finite and >= 1";
   for (std::size_t k = 0; k < clumps.size(); ++k)
     for (std::int32_t p : clumps[k].pebbles)
       if (!in(p, n) || balls.clump[static_cast<std::size_t>(p)] != static_cast<std::int32_t>(k))

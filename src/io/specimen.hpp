@@ -15,10 +15,11 @@
 namespace rocklab {
 
 /// 6: the header carries the body's checksum (`body_fnv1a64`). 7: the body ends with the balls'
-/// orientations (a tracking flag, then one quaternion per ball when it is on). Versions 5 (no
-/// checksum) and 6 are still read, as models without orientation tracking, and every version is
+/// orientations (a tracking flag, then one quaternion per ball when it is on). 8: then the density
+/// scaling factors (mass, then inertia; empty when off). Versions 5 (no checksum), 6 and 7 are
+/// still read, as models without orientation tracking or density scaling, and every version is
 /// validated field by field.
-inline constexpr int kSpecimenVersion = 7;
+inline constexpr int kSpecimenVersion = 8;
 
 /// Write atomically (temporary file, then rename). Throws std::runtime_error naming the file.
 void save_model(const Model& m, const std::string& path, const nlohmann::json& meta = {});
