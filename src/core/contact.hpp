@@ -50,6 +50,14 @@ struct ContactOutput {
   ContactStiffness stiff;     ///< stiffness for the time-step estimate
 };
 
+/// A contact's part of its ball's stiffness sums for the time-step estimate (translation; rotation
+/// about the ball's centre, `arm` from the centre to the contact point).
+inline void add_ball_stiffness(const ContactStiffness& s, const Vec3& arm, double& k_tran,
+                               double& k_rot) {
+  k_tran += s.k_tran;
+  k_rot += s.k_shear * arm.squaredNorm() + s.k_rot;
+}
+
 /// Force and moment in contact-plane coordinates (Fn > 0 tension).
 inline ContactResult local_components(const Contact& c, const ContactOutput& o) {
   return {-o.force.dot(c.n), o.force.dot(c.s),  o.force.dot(c.t),

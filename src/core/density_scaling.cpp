@@ -47,9 +47,7 @@ DensityScaling Model::scale_density(double quantile) {
     double k_tran = 0, k_rot = 0;
     for (std::int32_t a = adj_start_[i]; a < adj_start_[i + 1]; ++a) {
       const ContactOutput& c = outputs_[static_cast<std::size_t>(adj_items_[a] >> 1)];
-      const Vec3 arm = c.xc - balls.pos[i];
-      k_tran += c.stiff.k_tran;
-      k_rot += c.stiff.k_shear * arm.squaredNorm() + c.stiff.k_rot;
+      add_ball_stiffness(c.stiff, c.xc - balls.pos[i], k_tran, k_rot);
     }
     if (k_tran > 0)
       own[i].tran = std::sqrt(balls.mass[i] / k_tran);

@@ -166,8 +166,7 @@ double Model::sum_ball_forces() {
       const Vec3 arm = c.xc - xi;
       F += f;
       M += side * c.moment + arm.cross(f);
-      k_tran += c.stiff.k_tran;
-      k_rot += c.stiff.k_shear * arm.squaredNorm() + c.stiff.k_rot;
+      add_ball_stiffness(c.stiff, arm, k_tran, k_rot);
     }
     balls.force[i] = F;
     balls.moment[i] = M;
