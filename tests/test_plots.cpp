@@ -97,5 +97,20 @@ TEST(Plots, APngIsWrittenBesideEachSvg) {
   EXPECT_THROW(write_png_of_svg("<svg", dir / "bad.png"), std::runtime_error);
 }
 
+TEST(Plots, MarkerLabelsThatWouldOverlapAreStacked) {
+  // Stage markers of a calibration one evaluation apart: each label keeps its own line.
+  PlotSeries s{"e", {1, 2, 3, 4, 15}, {1, 2, 3, 2, 1}, "#000000", false};
+  const std::vector<PlotMarker> marks{{6, 0, "strength"}, {7, 0, "ratios"}, {12, 0, "elastic"}};
+  const std::string svg = line_plot_svg("t", "x", "y", "", {s}, marks);
+  auto y_of = [&](const std::string& label) {
+    const std::size_t at = svg.find(">" + label + "</text>");
+    EXPECT_NE(at, std::string::npos) << label;
+    const std::size_t y = svg.rfind(" y=\"", at);
+    return std::stod(svg.substr(y + 4));
+  };
+  EXPECT_LE(y_of("ratios"), y_of("strength") - 13); // a line higher: they would overlap
+  EXPECT_EQ(y_of("elastic"), y_of("strength"));     // far enough apart: same line
+}
+
 } // namespace
 } // namespace rocklab

@@ -258,12 +258,30 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
          "</text>\n";
     ly += 16;
   }
+  // A label that would overlap one already placed (about 7 px per character, 14 px a line) goes a
+  // line higher: markers one evaluation apart wrote "strengthratios" on the calibration plot.
+  struct Box {
+    double x0, x1, y;
+  };
+  std::vector<Box> placed;
   for (const PlotMarker& m : markers) {
     s += "<circle cx=\"" + num(f.X(m.x)) + "\" cy=\"" + num(f.Y(m.y, false)) +
          "\" r=\"4\" fill=\"none\" stroke=\"black\"/>\n";
     const bool right = f.X(m.x) > f.L + 0.85 * f.pw(); // keep the label inside the picture
-    s += "<text x=\"" + num(f.X(m.x) + (right ? -6 : 6)) + "\" y=\"" + num(f.Y(m.y, false) - 6) +
-         "\"" + (right ? " text-anchor=\"end\"" : "") + ">" + escape(m.label) + "</text>\n";
+    const double x = f.X(m.x) + (right ? -6 : 6), w = 7.0 * static_cast<double>(m.label.size());
+    const double x0 = right ? x - w : x, x1 = x0 + w;
+    double y = f.Y(m.y, false) - 6;
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const Box& b : placed)
+        if (x0 < b.x1 + 3 && b.x0 < x1 + 3 && std::abs(y - b.y) < 13) {
+          y = b.y - 14;
+          moved = true;
+        }
+    }
+    placed.push_back({x0, x1, y});
+    s += "<text x=\"" + num(x) + "\" y=\"" + num(y) + "\"" + (right ? " text-anchor=\"end\"" : "") +
+         ">" + escape(m.label) + "</text>\n";
   }
   s += "</svg>\n";
   return s;
