@@ -31,11 +31,13 @@ DensityScaling Model::scale_density(double quantile) {
   if (!initialized_)
     initialize();
   const std::size_t n = balls.size();
-  // Back to the true inertia first (each ball keeps its kinetic energy).
-  for (std::size_t i = 0; i < mass_scale_.size() && i < n; ++i) {
-    balls.vel[i] *= std::sqrt(mass_scale_[i]);
-    balls.spin[i] *= std::sqrt(inertia_scale_[i]);
-  }
+  // Back to the true inertia first (each ball keeps its kinetic energy). Factors left over from
+  // before the balls changed are not in effect (density_scaled()): nothing to undo then.
+  if (density_scaled())
+    for (std::size_t i = 0; i < n; ++i) {
+      balls.vel[i] *= std::sqrt(mass_scale_[i]);
+      balls.spin[i] *= std::sqrt(inertia_scale_[i]);
+    }
   mass_scale_.clear();
   inertia_scale_.clear();
   DensityScaling out;
