@@ -112,5 +112,16 @@ TEST(Plots, MarkerLabelsThatWouldOverlapAreStacked) {
   EXPECT_EQ(y_of("elastic"), y_of("strength"));     // far enough apart: same line
 }
 
+TEST(Plots, ASeriesWithOnePointIsDrawnAsADot) {
+  // A target measured only by a calibration's final evaluation has one point and no line.
+  PlotSeries one{"bts", {1, 2, 3}, {NAN, NAN, 4}, "#1f77b4", false};
+  PlotSeries many{"ucs", {1, 2, 3}, {5, 2, 1}, "#ff7f0e", false};
+  const std::string svg = line_plot_svg("t", "x", "y", "", {one, many});
+  const std::size_t dot = svg.find("<circle class=\"point\"");
+  ASSERT_NE(dot, std::string::npos);
+  EXPECT_NE(svg.find("fill=\"#1f77b4\"", dot), std::string::npos);
+  EXPECT_EQ(svg.find("<circle class=\"point\"", dot + 1), std::string::npos); // not for "ucs"
+}
+
 } // namespace
 } // namespace rocklab

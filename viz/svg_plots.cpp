@@ -245,12 +245,24 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
          ") rotate(90)\" text-anchor=\"middle\">" + escape(y2label) + "</text>\n";
   double ly = lg.y + 8;
   for (const PlotSeries& p : series) {
-    std::string pts;
+    std::string pts, dot;
+    int drawn = 0;
     for (std::size_t i = 0; i < p.x.size() && i < p.y.size(); ++i)
-      if (std::isfinite(p.x[i]) && std::isfinite(p.y[i]))
-        pts += num(f.X(p.x[i])) + "," + num(f.Y(p.y[i], p.right_axis)) + " ";
+      if (std::isfinite(p.x[i]) && std::isfinite(p.y[i])) {
+        const std::string xy = num(f.X(p.x[i])) + "," + num(f.Y(p.y[i], p.right_axis));
+        pts += xy + " ";
+        dot = xy;
+        ++drawn;
+      }
     s += "<polyline fill=\"none\" stroke=\"" + p.color + "\" stroke-width=\"1.6\"" + dash(p) +
          " points=\"" + pts + "\"/>\n";
+    // A series with one point draws no line: a dot shows it (a calibration target measured only by
+    // the final evaluation was invisible on the convergence plot).
+    if (drawn == 1) {
+      const std::size_t comma = dot.find(',');
+      s += "<circle class=\"point\" cx=\"" + dot.substr(0, comma) + "\" cy=\"" +
+           dot.substr(comma + 1) + "\" r=\"4\" fill=\"" + p.color + "\"/>\n";
+    }
     s += "<line class=\"legend\" x1=\"" + num(lg.x + 2) + "\" y1=\"" + num(ly) + "\" x2=\"" +
          num(lg.x + 26) + "\" y2=\"" + num(ly) + "\" stroke=\"" + p.color +
          "\" stroke-width=\"2\"" + dash(p) + "/>\n";
