@@ -137,6 +137,12 @@ bool segment_meets_box(double x0, double y0, double x1, double y1, const LegendB
   return true;
 }
 
+// Width of a label in the plots' 12 px sans-serif: about 7 px a character (the legend box, the
+// markers' clearance and the stacking of marker labels all use this estimate).
+double text_width(std::size_t chars) {
+  return 7.0 * static_cast<double>(chars);
+}
+
 // How many drawn segments, points and marker labels meet a box.
 std::size_t points_inside(const PlotFrame& f, const std::vector<PlotSeries>& series,
                           const std::vector<PlotMarker>& markers, const LegendBox& b) {
@@ -153,7 +159,7 @@ std::size_t points_inside(const PlotFrame& f, const std::vector<PlotSeries>& ser
   }
   for (const PlotMarker& m : markers) {
     const double x = f.X(m.x), y = f.Y(m.y, false);
-    const double w = 10 + 7.0 * static_cast<double>(m.label.size()); // the circle and its label
+    const double w = 10 + text_width(m.label.size()); // the circle and its label
     const bool right = x > f.L + 0.85 * f.pw();
     const double mx0 = right ? x - w : x - 4, mx1 = right ? x + 4 : x + w;
     n += mx0 < b.x + b.w + 4 && mx1 > b.x - 4 && y - 18 < b.y + b.h + 4 && y + 4 > b.y - 4;
@@ -169,7 +175,7 @@ LegendBox place_legend(PlotFrame& f, const std::vector<PlotSeries>& series,
   for (const PlotSeries& p : series)
     chars = std::max(chars, p.label.size());
   LegendBox b;
-  b.w = 44 + 7.0 * static_cast<double>(chars), b.h = 16.0 * static_cast<double>(series.size());
+  b.w = 44 + text_width(chars), b.h = 16.0 * static_cast<double>(series.size());
   if (series.empty())
     return b;
   for (int corner = 0; corner < 4; ++corner) {
@@ -245,24 +251,21 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
          ") rotate(90)\" text-anchor=\"middle\">" + escape(y2label) + "</text>\n";
   double ly = lg.y + 8;
   for (const PlotSeries& p : series) {
-    std::string pts, dot;
-    int drawn = 0;
+    std::string pts;
+    std::size_t drawn = 0, last = 0;
     for (std::size_t i = 0; i < p.x.size() && i < p.y.size(); ++i)
       if (std::isfinite(p.x[i]) && std::isfinite(p.y[i])) {
-        const std::string xy = num(f.X(p.x[i])) + "," + num(f.Y(p.y[i], p.right_axis));
-        pts += xy + " ";
-        dot = xy;
+        pts += num(f.X(p.x[i])) + "," + num(f.Y(p.y[i], p.right_axis)) + " ";
+        last = i;
         ++drawn;
       }
     s += "<polyline fill=\"none\" stroke=\"" + p.color + "\" stroke-width=\"1.6\"" + dash(p) +
          " points=\"" + pts + "\"/>\n";
     // A series with one point draws no line: a dot shows it (a calibration target measured only by
     // the final evaluation was invisible on the convergence plot).
-    if (drawn == 1) {
-      const std::size_t comma = dot.find(',');
-      s += "<circle class=\"point\" cx=\"" + dot.substr(0, comma) + "\" cy=\"" +
-           dot.substr(comma + 1) + "\" r=\"4\" fill=\"" + p.color + "\"/>\n";
-    }
+    if (drawn == 1)
+      s += "<circle class=\"point\" cx=\"" + num(f.X(p.x[last])) + "\" cy=\"" +
+           num(f.Y(p.y[last], p.right_axis)) + "\" r=\"4\" fill=\"" + p.color + "\"/>\n";
     s += "<line class=\"legend\" x1=\"" + num(lg.x + 2) + "\" y1=\"" + num(ly) + "\" x2=\"" +
          num(lg.x + 26) + "\" y2=\"" + num(ly) + "\" stroke=\"" + p.color +
          "\" stroke-width=\"2\"" + dash(p) + "/>\n";
@@ -280,7 +283,7 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
     s += "<circle cx=\"" + num(f.X(m.x)) + "\" cy=\"" + num(f.Y(m.y, false)) +
          "\" r=\"4\" fill=\"none\" stroke=\"black\"/>\n";
     const bool right = f.X(m.x) > f.L + 0.85 * f.pw(); // keep the label inside the picture
-    const double x = f.X(m.x) + (right ? -6 : 6), w = 7.0 * static_cast<double>(m.label.size());
+    const double x = f.X(m.x) + (right ? -6 : 6), w = text_width(m.label.size());
     const double x0 = right ? x - w : x, x1 = x0 + w;
     double y = f.Y(m.y, false) - 6;
     for (bool moved = true; moved;) {
