@@ -123,5 +123,40 @@ TEST(Plots, ASeriesWithOnePointIsDrawnAsADot) {
   EXPECT_EQ(svg.find("<circle class=\"point\"", dot + 1), std::string::npos); // not for "ucs"
 }
 
+TEST(Plots, ALogAxisHasDecadeTicksAndKeepsDistantValuesApart) {
+  // The calibration's errors in tolerances: 49 (direct tension) and 5.7 (BTS) were one point on a
+  // linear axis clipped at 5.
+  PlotSeries dt{"dt", {1, 2, 3}, {49.4, 12, 0.5}, "#2ca02c", false};
+  PlotSeries bts{"bts", {1, 2, 3}, {5.7, 0.03, 0.2}, "#1f77b4", false};
+  const std::vector<PlotMarker> marks{{1, 0, "elastic"}};
+  const std::string svg = line_plot_svg("t", "x", "y", "", {dt, bts}, marks, NAN, true);
+  const auto yt = test::svg_ticks(svg, "ytick");
+  ASSERT_GE(yt.size(), 4u);
+  std::vector<std::string> labels;
+  for (const auto& t : yt)
+    labels.push_back(t.text);
+  EXPECT_EQ(labels.front(), "0.01");
+  EXPECT_EQ(labels.back(), "100");
+  EXPECT_NE(std::find(labels.begin(), labels.end(), "1"), labels.end());
+  // equal spacing per decade, and each point at log10 of its value between the ticks
+  const double per_decade = yt[0].pos - yt[1].pos;
+  for (std::size_t i = 1; i < yt.size(); ++i)
+    EXPECT_NEAR(yt[i - 1].pos - yt[i].pos, per_decade, 0.02);
+  const auto lines = test::svg_polylines(svg);
+  ASSERT_EQ(lines.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const PlotSeries& p = k == 0 ? dt : bts;
+    for (std::size_t i = 0; i < p.y.size(); ++i) {
+      const double decades = (yt[0].pos - lines[k][i].second) / per_decade; // above 0.01
+      EXPECT_NEAR(std::pow(10.0, decades - 2), p.y[i], 1e-3 * p.y[i]);
+    }
+  }
+  // the marker at 0 sits on the bottom axis
+  const std::size_t c = svg.find("<circle cx=");
+  ASSERT_NE(c, std::string::npos);
+  const std::size_t cy = svg.find("cy=\"", c);
+  EXPECT_NEAR(std::stod(svg.substr(cy + 4)), yt[0].pos, 0.02);
+}
+
 } // namespace
 } // namespace rocklab

@@ -63,8 +63,11 @@ std::string tick_label(double v, int digits) {
 
 // An axis: its limits are whole multiples of its tick step, and its ticks are the multiples k *
 // step between them (computed from k, so no drift and no tick off the grid).
+// On a log axis the values are log10 of the data: the ticks fall on whole decades and are labelled
+// with the data value (0.01, 0.1, 1, 10, ...).
 struct Range1 {
   double lo = 1e300, hi = -1e300, step = 1;
+  bool log = false;
   void add(double v) {
     if (std::isfinite(v)) {
       lo = std::min(lo, v);
@@ -76,7 +79,7 @@ struct Range1 {
       lo = 0, hi = 1;
     if (hi - lo <= 0)
       hi = lo + 1;
-    step = tick_step(hi - lo);
+    step = log ? std::max(1.0, std::ceil((hi - lo) / 8 - 1e-9)) : tick_step(hi - lo);
     lo = std::floor(lo / step + 1e-9) * step;
     hi = std::ceil(hi / step - 1e-9) * step;
   }
@@ -85,9 +88,15 @@ struct Range1 {
     std::vector<std::pair<double, std::string>> t;
     const long k0 = std::lround(lo / step), k1 = std::lround(hi / step);
     const int digits = tick_digits(step);
-    for (long k = k0; k <= k1; ++k)
-      t.emplace_back(static_cast<double>(k) * step,
-                     tick_label(static_cast<double>(k) * step, digits));
+    for (long k = k0; k <= k1; ++k) {
+      const double v = static_cast<double>(k) * step;
+      if (!log)
+        t.emplace_back(v, tick_label(v, digits));
+      else if (std::abs(v) <= 4)
+        t.emplace_back(v, tick_label(std::pow(10.0, v), v < 0 ? static_cast<int>(-v) : 0));
+      else
+        t.emplace_back(v, "1e" + std::to_string(std::lround(v)));
+    }
     return t;
   }
 };
@@ -221,9 +230,25 @@ std::string dash(const PlotSeries& p) {
 
 std::string line_plot_svg(const std::string& title, const std::string& xlabel,
                           const std::string& ylabel, const std::string& y2label,
-                          const std::vector<PlotSeries>& series,
-                          const std::vector<PlotMarker>& markers, double y_top) {
+                          const std::vector<PlotSeries>& series_in,
+                          const std::vector<PlotMarker>& markers_in, double y_top, bool log_y) {
+  // A log left axis plots log10 of the data; a value <= 0 has no place on it (a marker there sits
+  // on the axis' bottom).
+  std::vector<PlotSeries> logged;
+  std::vector<PlotMarker> markers = markers_in;
+  if (log_y) {
+    auto lg = [](double v) { return v > 0 ? std::log10(v) : NAN; };
+    logged = series_in;
+    for (PlotSeries& p : logged)
+      if (!p.right_axis)
+        std::transform(p.y.begin(), p.y.end(), p.y.begin(), lg);
+    for (PlotMarker& m : markers)
+      m.y = lg(m.y);
+    y_top = lg(y_top);
+  }
+  const std::vector<PlotSeries>& series = log_y ? logged : series_in;
   PlotFrame f;
+  f.ry.log = log_y;
   f.R = y2label.empty() ? 30 : 80;
   bool has2 = false;
   for (const PlotSeries& p : series)
@@ -235,6 +260,9 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
   if (std::isfinite(y_top))
     f.ry.add(y_top);
   f.rx.finish(), f.ry.finish(), f.ry2.finish();
+  for (PlotMarker& m : markers)
+    if (!std::isfinite(m.y))
+      m.y = f.ry.lo;
   const LegendBox lg = place_legend(f, series, markers);
   std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + num(f.W) + "\" height=\"" +
                   num(f.H) + "\" font-family=\"sans-serif\" font-size=\"12\">\n";

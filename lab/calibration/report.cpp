@@ -110,9 +110,11 @@ std::string convergence_csv(const CalibrationFile& c, const Outcome& out) {
 }
 
 std::string convergence_svg(const CalibrationFile& c, const Outcome& out) {
-  // |error| in tolerances per target, clipped at kClip so that the last evaluations stay legible;
-  // a target not measured in a stage (e.g. BTS during the UCS-only stages) has no point there.
-  constexpr double kClip = 5;
+  // |error| in tolerances per target on a log axis, so that a first guess 50 tolerances off and a
+  // converged 0.1 both stay legible (a linear axis clipped at 5 drew BTS and direct tension on the
+  // same point); a target not measured in a stage (e.g. BTS during the UCS-only stages) has no
+  // point there; a hit closer than kFloor is drawn at kFloor.
+  constexpr double kFloor = 0.01;
   static const char* const colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
                                        "#ff7f0e", "#8c564b", "#e377c2", "#17becf"};
   std::vector<PlotSeries> series;
@@ -125,7 +127,7 @@ std::string convergence_svg(const CalibrationFile& c, const Outcome& out) {
       const double m = value_of(r.measured, c.targets[k].property);
       if (std::isfinite(m)) {
         p.x.push_back(r.evaluation);
-        p.y.push_back(std::min(kClip, std::abs(c.targets[k].error(m))));
+        p.y.push_back(std::max(kFloor, std::abs(c.targets[k].error(m))));
       }
     }
     series.push_back(p);
@@ -140,8 +142,7 @@ std::string convergence_svg(const CalibrationFile& c, const Outcome& out) {
   }
   series.push_back(tol);
   return line_plot_svg("Calibration " + c.name + ": error per target", "evaluation",
-                       "|error| / tolerance (clipped at 5)", "", series, stages,
-                       kClip + 0.3 * static_cast<double>(series.size()));
+                       "|error| / tolerance (log scale)", "", series, stages, NAN, true);
 }
 
 std::string report_md(const ReportInput& r) {
