@@ -226,26 +226,32 @@ std::string dash(const PlotSeries& p) {
   return p.dashed ? " stroke-dasharray=\"6,4\"" : "";
 }
 
+// A log left axis plots log10 of the data: the left-axis series (returned), the markers and y_top
+// are mapped; a value <= 0 has no place on it (NaN: not drawn; a marker there later sits on the
+// axis' bottom).
+std::vector<PlotSeries> to_log_axis(const std::vector<PlotSeries>& series,
+                                    std::vector<PlotMarker>& markers, double& y_top) {
+  auto lg = [](double v) { return v > 0 ? std::log10(v) : NAN; };
+  std::vector<PlotSeries> logged = series;
+  for (PlotSeries& p : logged)
+    if (!p.right_axis)
+      std::transform(p.y.begin(), p.y.end(), p.y.begin(), lg);
+  for (PlotMarker& m : markers)
+    m.y = lg(m.y);
+  y_top = lg(y_top);
+  return logged;
+}
+
 } // namespace
 
 std::string line_plot_svg(const std::string& title, const std::string& xlabel,
                           const std::string& ylabel, const std::string& y2label,
                           const std::vector<PlotSeries>& series_in,
                           const std::vector<PlotMarker>& markers_in, double y_top, bool log_y) {
-  // A log left axis plots log10 of the data; a value <= 0 has no place on it (a marker there sits
-  // on the axis' bottom).
   std::vector<PlotSeries> logged;
   std::vector<PlotMarker> markers = markers_in;
-  if (log_y) {
-    auto lg = [](double v) { return v > 0 ? std::log10(v) : NAN; };
-    logged = series_in;
-    for (PlotSeries& p : logged)
-      if (!p.right_axis)
-        std::transform(p.y.begin(), p.y.end(), p.y.begin(), lg);
-    for (PlotMarker& m : markers)
-      m.y = lg(m.y);
-    y_top = lg(y_top);
-  }
+  if (log_y)
+    logged = to_log_axis(series_in, markers, y_top);
   const std::vector<PlotSeries>& series = log_y ? logged : series_in;
   PlotFrame f;
   f.ry.log = log_y;
