@@ -537,8 +537,8 @@ TEST(CalibrationFile, ShippedTargetsLoadAndBadFilesExitWithTwo) {
   EXPECT_EQ(c.targets.size(), 7u);
   EXPECT_EQ(c.params.size(), 8u);
   // Every shipped calibration file loads (its card, parameters and tests agree).
-  for (const char* f :
-       {"lac_du_bonnet.json", "berea.json", "acceptance/lac_du_bonnet_2d_2x_off.json"})
+  for (const char* f : {"lac_du_bonnet.json", "lac_du_bonnet_slits.json", "berea.json",
+                        "acceptance/lac_du_bonnet_2d_2x_off.json"})
     EXPECT_NO_THROW(load_calibration(rocklab::test::source_dir() + "/lab/calibrate/" + f)) << f;
   EXPECT_EQ(
       load_calibration(rocklab::test::source_dir() + "/lab/calibrate/berea.json").targets.size(),
