@@ -1,5 +1,7 @@
 #include "lab/frame_snapshot.hpp"
 
+#include "io/results.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -66,12 +68,12 @@ EventClustering fracture_events(const LoadingFrame& f, const Protocol& p, nlohma
   for (std::size_t i = 0; i < b.size(); ++i)
     rsum += b.radius[i], rho += b.density[i];
   const double n = std::max<double>(1, static_cast<double>(b.size()));
-  double e = r.value("youngs_modulus_Pa", 0.0);
+  double e = json_number(r, "youngs_modulus_Pa", 0.0); // null where E could not be fitted
   std::string method = "output.event_window_s";
   double window = p.event_window;
   if (!(window > 0)) {
-    if (!(e > 0) && r.value("peak_axial_strain", 0.0) > 0) // no elastic fit: the peak secant
-      e = r.value("peak_stress_Pa", 0.0) / r.value("peak_axial_strain", 1.0);
+    if (!(e > 0) && json_number(r, "peak_axial_strain", 0.0) > 0) // no fit: the peak secant
+      e = json_number(r, "peak_stress_Pa", 0.0) / json_number(r, "peak_axial_strain", 1.0);
     window = default_event_window(e, rho / n, 2 * rsum / n);
     method = "5 mean grain diameters / P-wave speed sqrt(E / grain density)";
   }

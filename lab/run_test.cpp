@@ -378,9 +378,7 @@ LabSummary FrameTest::run(const nlohmann::json&, const std::string& file, const 
 
 void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
   const nlohmann::json& r = s.results;
-  auto mpa = [&](const char* key) {
-    return r.contains(key) && r[key].is_number() ? r[key].get<double>() * 1e-6 : 0.0;
-  };
+  auto mpa = [&](const char* key) { return json_number(r, key, 0.0) * 1e-6; };
   std::printf("test         %s   material %s   grains %lld   steps %lld\n",
               r["test"].get<std::string>().c_str(),
               r["provenance"]["material"].get<std::string>().c_str(),

@@ -165,7 +165,7 @@ std::string last_lines(const std::string& file, int n) {
 }
 
 double num(const nlohmann::json& r, const char* key) {
-  return r.contains(key) && r[key].is_number() ? r[key].get<double>() : std::nan("");
+  return json_number(r, key, std::nan(""));
 }
 
 nlohmann::json or_null(double v) {

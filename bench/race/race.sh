@@ -2,9 +2,12 @@
 # The same-specimen race with YADE (issue 15). Usage: bench/race/race.sh [RADIUS_m] [YADE_STEPS]
 # YADE (Debian package `yade`) makes a dense packing of a 16 mm x 32 mm cylinder (default mean
 # radius 0.41 mm: about 10k spheres); rocklab imports exactly that packing (`packing.import`) with
-# 8-element flat joints and with parallel bonds, bonding the pairs YADE's JCFpm bonds (gap within
-# 0.1 (R1 + R2): interaction factor 1.1); both run the elastic window of a UCS at 1 and 2 threads.
-# Prints contact-steps per second of each and the ratios to YADE. Units SI. Run on a quiet machine.
+# parallel bonds, 8-element flat joints and exact 3D flat joints, bonding the pairs YADE's JCFpm
+# bonds (gap within 0.1 (R1 + R2): interaction factor 1.1); both run the elastic window of a UCS
+# (top platen at 1/s axial strain rate to 0.02 % axial strain) at 1 and 2 threads. Prints
+# contact-steps per second of each and the ratios to YADE, and the wall time each code needs for
+# that window: rocklab's whole test (set-up, seating, loading, output) against YADE's measured time
+# per step times the steps its own time step needs for 0.02 % at 1/s. Units SI. Quiet machine.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$here/../.."
@@ -22,7 +25,7 @@ if [ "$(cat radius 2> /dev/null)" != "$radius" ] || [ ! -s packing.txt ]; then
   yade -n -x "$here/yade_packing.py" packing.txt "$radius" 2>&1 | grep '^spheres'
   echo "$radius" > radius
 fi
-for model in fj pb; do
+for model in pb fj fjx; do
   if ! cmp -s "$here/race_$model.json" "card_$model.json" || [ ! -s "spec_$model.rlspec" ] ||
     [ packing.txt -nt "spec_$model.rlspec" ]; then
     cp "$here/race_$model.json" "card_$model.json"
@@ -48,12 +51,26 @@ def rocklab(model, t):
     rep = json.load(open(f"{out}/spec_{model}.rlspec.report.json"))
     p = json.load(open(f"{out}/ucs_{model}_{t}/results.json"))["provenance"]
     return rep["contacts"]["total"] * p["steps"] / p["wall_time_s"], rep["contacts"]["total"], p["steps"]
+def yade_window(t):  # YADE's wall time for the same 0.02 % at 1/s: its steps at its own dt
+    w = open(f"{out}/yade_{t}.txt").read().split()
+    return float(w[9]) / int(w[7]) * (2 + 0.0002 / float(w[5]))
 y = {t: yade(t) for t in (1, 2)}
 print(f"YADE JCFpm: {y[1]/1e6:.2f} M contact-steps/s (1 thread), {y[2]/1e6:.2f} M (2 threads)")
 print("| engine / model | contacts | steps | 1 thread M/s | x YADE | 2 threads M/s | x YADE | 2nd thread |")
 print("|---|---|---|---|---|---|---|---|")
-for model, name in (("pb", "rocklab parallel bond"), ("fj", "rocklab flat joint, 8 elements")):
+models = (("pb", "rocklab parallel bond"), ("fj", "rocklab flat joint, 8 elements"),
+          ("fjx", "rocklab flat joint, exact 3D"))
+for model, name in models:
     r1, n, s = rocklab(model, 1)
     r2, _, _ = rocklab(model, 2)
     print(f"| {name} | {n} | {s} | {r1/1e6:.2f} | {r1/y[1]:.2f} | {r2/1e6:.2f} | {r2/y[2]:.2f} | {r2/r1:.2f} |")
+print()
+print("Wall time of the window (0.02 % axial strain at 1/s) [s]; YADE: its time per step x its steps")
+print("| engine / model | 1 thread | / YADE | 2 threads | / YADE |")
+print("|---|---|---|---|---|")
+print(f"| YADE JCFpm | {yade_window(1):.1f} | 1 | {yade_window(2):.1f} | 1 |")
+for model, name in models:
+    w = [json.load(open(f"{out}/ucs_{model}_{t}/results.json"))["provenance"]["wall_time_s"]
+         for t in (1, 2)]
+    print(f"| {name} | {w[0]:.1f} | {w[0]/yade_window(1):.2f} | {w[1]:.1f} | {w[1]/yade_window(2):.2f} |")
 PY

@@ -34,4 +34,11 @@ std::string history_row(const Model& m, const std::vector<HistoryColumn>& cols,
 /// Shortest text that reads back to the same double.
 std::string format_double(double v);
 
+/// A number of a results object, or `fallback` where the key is missing or not a number (a
+/// measurement that could not be made is written as null).
+inline double json_number(const nlohmann::json& r, const char* key, double fallback) {
+  const auto it = r.find(key);
+  return it != r.end() && it->is_number() ? it->get<double>() : fallback;
+}
+
 } // namespace rocklab
