@@ -392,6 +392,49 @@ TEST(CalibrationFile, BadFilesNameTheKeyAndWhatIsAllowed) {
   EXPECT_NE(error_of(j).find("key 'material': /dev/zero"), std::string::npos) << error_of(j);
 }
 
+// A variant names only what differs ("extends"): every other key is the extended file's, a key it
+// gives replaces the extended one whole, and its material path is read from the file that gave it.
+TEST(CalibrationFile, AVariantExtendsAFileAndReplacesWholeKeys) {
+  const std::string dir = rocklab::test::source_dir() + "/lab/calibrate/";
+  const CalibrationFile base = load_calibration(dir + "lac_du_bonnet.json");
+  const CalibrationFile slits = load_calibration(dir + "lac_du_bonnet_slits.json");
+  EXPECT_EQ(slits.name, "lac-du-bonnet-3d-slits");
+  EXPECT_EQ(slits.tests, base.tests);
+  EXPECT_EQ(slits.seeds, base.seeds);
+  ASSERT_EQ(slits.targets.size(), base.targets.size());
+  ASSERT_EQ(slits.params.size(), base.params.size());
+  EXPECT_EQ(slits.budget.ratios, 0); // its own budget, not the defaults
+  EXPECT_EQ(std::filesystem::path(slits.material_file).filename(),
+            "granite_fj_3d_slits_start.json");
+  EXPECT_NE(slits.material, base.material);
+
+  write_calibration("ext_base", good_calibration());
+  const nlohmann::json child = {{"extends", "ext_base.json"}, {"seeds", {4, 5}}};
+  const CalibrationFile c = load_calibration(write_calibration("ext_child", child));
+  const CalibrationFile b = load_calibration(write_calibration("ext_base", good_calibration()));
+  EXPECT_EQ(c.seeds, (std::vector<std::uint64_t>{4, 5}));
+  EXPECT_EQ(c.tests, b.tests);
+  EXPECT_EQ(c.material_file, b.material_file);
+  // A missing file, a wrong type and a file extending itself name the key.
+  EXPECT_NE(error_of({{"extends", "no_such.json"}}).find("key 'extends': "), std::string::npos);
+  EXPECT_NE(error_of({{"extends", "no_such.json"}}).find("does not exist"), std::string::npos);
+  EXPECT_NE(error_of({{"extends", 3}}).find("key 'extends': a calibration file's path"),
+            std::string::npos);
+  const std::string self = write_calibration("ext_self", {{"extends", "ext_self.json"}});
+  try {
+    load_calibration(self);
+    ADD_FAILURE() << "a file extending itself loaded";
+  } catch (const rocklab::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("more than 8 files deep"), std::string::npos) << e.what();
+  }
+  // An error in the extended file names the chain.
+  nlohmann::json bad = good_calibration();
+  bad["budgte"] = 1;
+  write_calibration("ext_bad_base", bad);
+  const std::string msg = error_of({{"extends", "ext_bad_base.json"}});
+  EXPECT_NE(msg.find("budgte"), std::string::npos) << msg;
+}
+
 // ---------------------------------------------------------------------------------------------
 // rocklab calibrate end to end on a tiny 2D specimen: E and UCS from a card 2-4x off; a run
 // interrupted after its first evaluation resumes from the cache; a rerun runs nothing.

@@ -177,12 +177,41 @@ void check_coverage(const CalibrationFile& c, JsonObject& top) {
     }
 }
 
+// A calibration file read with its "extends" chain: the named file's keys, each replaced whole by
+// the extending file's own (so a variant names only what differs: its start card, its budget).
+// `material_from` is the file whose "material" the result uses (its path is relative to that file).
+nlohmann::json read_extended(const std::string& path, std::string& material_from, int depth = 0) {
+  nlohmann::json j = read_json_file(path);
+  material_from = path;
+  if (!j.is_object() || !j.contains("extends"))
+    return j;
+  const nlohmann::json& e = j["extends"];
+  if (!e.is_string() || e.get<std::string>().empty())
+    throw InputError(path + ": key 'extends': a calibration file's path (a string)");
+  const std::string base = resolve(path, e.get<std::string>());
+  if (!fs::exists(base))
+    throw InputError(path + ": key 'extends': \"" + base + "\" does not exist");
+  if (depth >= 8)
+    throw InputError(path + ": key 'extends': more than 8 files deep (a file extending itself?)");
+  std::string base_material;
+  nlohmann::json merged =
+      named_by(path, "extends", [&] { return read_extended(base, base_material, depth + 1); });
+  if (!merged.is_object())
+    throw InputError(path + ": key 'extends': \"" + base + "\" is not a JSON object");
+  material_from = j.contains("material") ? path : base_material;
+  for (const auto& [key, v] : j.items())
+    if (key != "extends")
+      merged[key] = v;
+  return merged;
+}
+
 } // namespace
 
 CalibrationFile load_calibration(const std::string& path) {
   CalibrationFile c;
   c.file = path;
-  const nlohmann::json j = read_json_file(path);
+  std::string material_from;
+  const nlohmann::json j = read_extended(path, material_from);
   JsonObject top(j, path, "");
   if (top.has("units") && top.string("units") != "SI")
     top.fail("units", "only \"SI\" is supported");
@@ -190,7 +219,7 @@ CalibrationFile load_calibration(const std::string& path) {
   top.string("description", "");
   top.string("source", "");
   const std::string m = top.string("material");
-  c.material_file = resolve(path, m);
+  c.material_file = resolve(material_from, m);
   if (!fs::exists(c.material_file))
     top.fail("material", "\"" + c.material_file + "\" does not exist");
   // The base card must be valid on its own.
