@@ -399,17 +399,14 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
                 shown("youngs_modulus_Pa", "%.4g GPa", 1e-9).c_str(),
                 shown("youngs_modulus_secant_Pa", "%.4g GPa", 1e-9).c_str(),
                 shown("poisson_ratio", "%.3f", 1).c_str());
-    auto ratio = [&](const char* key) {
-      const nlohmann::json& v = r["crack_stresses"][key];
-      return v.is_number() ? v.get<double>() : 0.0;
-    };
+    auto ratio = [&](const char* key) { return json_number(r["crack_stresses"], key, 0.0); };
     if (r.contains("crack_stresses"))
       std::printf("crack stress initiation %.4g MPa (%.2f of peak; volumetric %.4g MPa), damage "
                   "%.4g MPa (%.2f)\n",
                   mpa("crack_initiation_stress_Pa"), ratio("crack_initiation_ratio"),
                   mpa("crack_initiation_stress_volumetric_Pa"), mpa("crack_damage_stress_Pa"),
                   ratio("crack_damage_ratio"));
-    if (r.value("confinement_Pa", 0.0) > 0)
+    if (json_number(r, "confinement_Pa", 0.0) > 0)
       std::printf("confinement  %.4g MPa (held between %.4g and %.4g MPa)\n", mpa("confinement_Pa"),
                   1e-6 * r["confinement_measured_Pa"]["min"].get<double>(),
                   1e-6 * r["confinement_measured_Pa"]["max"].get<double>());

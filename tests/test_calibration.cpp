@@ -408,10 +408,10 @@ TEST(CalibrationFile, AVariantExtendsAFileAndReplacesWholeKeys) {
             "granite_fj_3d_slits_start.json");
   EXPECT_NE(slits.material, base.material);
 
-  write_calibration("ext_base", good_calibration());
+  const std::string base_file = write_calibration("ext_base", good_calibration());
   const nlohmann::json child = {{"extends", "ext_base.json"}, {"seeds", {4, 5}}};
   const CalibrationFile c = load_calibration(write_calibration("ext_child", child));
-  const CalibrationFile b = load_calibration(write_calibration("ext_base", good_calibration()));
+  const CalibrationFile b = load_calibration(base_file);
   EXPECT_EQ(c.seeds, (std::vector<std::uint64_t>{4, 5}));
   EXPECT_EQ(c.tests, b.tests);
   EXPECT_EQ(c.material_file, b.material_file);

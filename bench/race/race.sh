@@ -44,33 +44,32 @@ done
 python3 - "$out" <<'PY'
 import json, sys
 out = sys.argv[1]
-def yade(t):
+def yade(t):  # "RACE yade interactions N dt DT steps S wall W"
     w = open(f"{out}/yade_{t}.txt").read().split()
-    return int(w[3]) * int(w[7]) / float(w[9])
-def rocklab(model, t):
+    n, dt, steps, wall = int(w[3]), float(w[5]), int(w[7]), float(w[9])
+    # contact-steps per second, and the wall time of the same 0.02 % at 1/s at YADE's own dt
+    return n * steps / wall, wall / steps * (2 + 0.0002 / dt)
+def rocklab(model, t):  # contact-steps per second, contacts, steps, wall time of the whole test
     rep = json.load(open(f"{out}/spec_{model}.rlspec.report.json"))
     p = json.load(open(f"{out}/ucs_{model}_{t}/results.json"))["provenance"]
-    return rep["contacts"]["total"] * p["steps"] / p["wall_time_s"], rep["contacts"]["total"], p["steps"]
-def yade_window(t):  # YADE's wall time for the same 0.02 % at 1/s: its steps at its own dt
-    w = open(f"{out}/yade_{t}.txt").read().split()
-    return float(w[9]) / int(w[7]) * (2 + 0.0002 / float(w[5]))
+    n = rep["contacts"]["total"]
+    return n * p["steps"] / p["wall_time_s"], n, p["steps"], p["wall_time_s"]
 y = {t: yade(t) for t in (1, 2)}
-print(f"YADE JCFpm: {y[1]/1e6:.2f} M contact-steps/s (1 thread), {y[2]/1e6:.2f} M (2 threads)")
-print("| engine / model | contacts | steps | 1 thread M/s | x YADE | 2 threads M/s | x YADE | 2nd thread |")
-print("|---|---|---|---|---|---|---|---|")
 models = (("pb", "rocklab parallel bond"), ("fj", "rocklab flat joint, 8 elements"),
           ("fjx", "rocklab flat joint, exact 3D"))
-for model, name in models:
-    r1, n, s = rocklab(model, 1)
-    r2, _, _ = rocklab(model, 2)
-    print(f"| {name} | {n} | {s} | {r1/1e6:.2f} | {r1/y[1]:.2f} | {r2/1e6:.2f} | {r2/y[2]:.2f} | {r2/r1:.2f} |")
+r = {(m, t): rocklab(m, t) for m, _ in models for t in (1, 2)}
+print(f"YADE JCFpm: {y[1][0]/1e6:.2f} M contact-steps/s (1 thread), {y[2][0]/1e6:.2f} M (2 threads)")
+print("| engine / model | contacts | steps | 1 thread M/s | x YADE | 2 threads M/s | x YADE | 2nd thread |")
+print("|---|---|---|---|---|---|---|---|")
+for m, name in models:
+    (r1, n, s, _), r2 = r[m, 1], r[m, 2][0]
+    print(f"| {name} | {n} | {s} | {r1/1e6:.2f} | {r1/y[1][0]:.2f} | {r2/1e6:.2f} | {r2/y[2][0]:.2f} | {r2/r1:.2f} |")
 print()
 print("Wall time of the window (0.02 % axial strain at 1/s) [s]; YADE: its time per step x its steps")
 print("| engine / model | 1 thread | / YADE | 2 threads | / YADE |")
 print("|---|---|---|---|---|")
-print(f"| YADE JCFpm | {yade_window(1):.1f} | 1 | {yade_window(2):.1f} | 1 |")
-for model, name in models:
-    w = [json.load(open(f"{out}/ucs_{model}_{t}/results.json"))["provenance"]["wall_time_s"]
-         for t in (1, 2)]
-    print(f"| {name} | {w[0]:.1f} | {w[0]/yade_window(1):.2f} | {w[1]:.1f} | {w[1]/yade_window(2):.2f} |")
+print(f"| YADE JCFpm | {y[1][1]:.1f} | 1 | {y[2][1]:.1f} | 1 |")
+for m, name in models:
+    w1, w2 = r[m, 1][3], r[m, 2][3]
+    print(f"| {name} | {w1:.1f} | {w1/y[1][1]:.2f} | {w2:.1f} | {w2/y[2][1]:.2f} |")
 PY
