@@ -286,6 +286,7 @@ void write_plots(const FrameTest& test, const LoadingFrame& f, const nlohmann::j
 
 void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::time_point t0) {
   const LoadingFrame& f = *frame;
+  model->release_scratch(); // the run is over: its detection scratch is not needed
   // The final snapshot, and the latest peak snapshot (as the "peak" files, placed in the .pvd by
   // its time; a checkpoint may have written an earlier one already).
   if (p.vtk) {

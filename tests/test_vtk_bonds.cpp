@@ -1,5 +1,6 @@
 // Every bonded contact model's bonds appear in the ParaView bond series (bonds_*.vtp), intact and
 // then broken, with the model's registry index in the "model" cell array.
+// The faced-grain cells file written in pieces equals the one written whole.
 #include "helpers.hpp"
 
 #include "contact/model_json.hpp"
@@ -8,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <random>
 
 using namespace rocklab;
 namespace fs = std::filesystem;
@@ -85,4 +87,74 @@ TEST(VtkBonds, EveryBondedModelIsDrawnIntactThenBroken) {
     SCOPED_TRACE(name);
     EXPECT_TRUE(name == "linear" || name == "powerplastic") << "a new model: add its bonded case";
   }
+}
+
+// The cells file is made and written a piece of grains at a time (memory at 10k grains, issue
+// 15): cut into 7 pieces it holds the same polygons, fields and crack faces as in one piece.
+TEST(VtkCells, APiecewiseCellsFileEqualsTheWholeOne) {
+  nlohmann::json balls = nlohmann::json::array();
+  const double d = 1e-3;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(-0.1 * d, 0.1 * d);
+  int id = 0;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j)
+      for (int k = 0; k < 6; ++k)
+        balls.push_back(
+            {{"id", ++id},
+             {"position", {i * d + jitter(rng), j * d + jitter(rng), k * d + jitter(rng)}},
+             {"radius", 0.35 * d},
+             {"density", 2650},
+             {"fix", "all"}});
+  const nlohmann::json scene = {
+      {"dimension", 3},
+      {"timestep", 1e-7},
+      {"balls", balls},
+      {"contact_models",
+       {{{"between", "ball-ball"}, {"model", "linear"}, {"properties", {{"kn", 1e6}}}}}},
+      {"run", {{"cycles", 1}}}};
+  const fs::path file = test::scratch_root() / "vtk-cells-scene.json";
+  std::ofstream(file) << scene.dump(1);
+  Scene s = load_scene(file.string());
+  s.model->initialize();
+  const Snapshot frame = take_snapshot(*s.model, {}, 0.0);
+  // cracks between lattice neighbours along x: grain id n and n + 36
+  const auto at = [&](double) {
+    Snapshot c;
+    c.dim = 3;
+    for (std::int64_t n = 1; n <= 100; n += 9) {
+      c.contact_cracks.push_back(CrackGlyph{});
+      c.contact_crack_grains.push_back({n, n + 36});
+    }
+    return c;
+  };
+  struct Written {
+    CellSummary sum;
+    VtkFileInfo cells, faces;
+  };
+  const auto write = [&](const std::string& name, std::size_t per_piece) {
+    const fs::path dir = test::scratch_root() / ("vtk-cells-" + name);
+    fs::remove_all(dir);
+    VtkSeries vtk(dir);
+    vtk.set_cell_piece_grains(per_piece);
+    vtk.write(frame);
+    Written w;
+    w.sum = vtk.write_fractures(at, true);
+    w.cells = read_vtk_info((dir / "cells_0000.vtp").string());
+    w.faces = read_vtk_info((dir / "contact_cracks_0000.vtp").string());
+    return w;
+  };
+  const Written one = write("one", 1024), seven = write("seven", 31);
+  EXPECT_EQ(one.sum.grains, 216u);
+  EXPECT_GT(one.cells.cells, 6 * 216); // every cell has at least six faces
+  EXPECT_EQ(seven.cells.cells, one.cells.cells);
+  EXPECT_EQ(seven.cells.points, one.cells.points);
+  EXPECT_EQ(seven.cells.positions, one.cells.positions);
+  for (const char* a : {"grain", "cell_volume", "boundary", "radius"})
+    EXPECT_EQ(seven.cells.cell_values.at(a), one.cells.cell_values.at(a)) << a;
+  EXPECT_EQ(seven.sum.volume_sum, one.sum.volume_sum);
+  EXPECT_EQ(seven.sum.hidden, one.sum.hidden);
+  EXPECT_EQ(one.sum.faced_cracks, 12u); // every crack between neighbours is their shared face
+  EXPECT_EQ(seven.sum.faced_cracks, one.sum.faced_cracks);
+  EXPECT_EQ(seven.faces.positions, one.faces.positions);
 }

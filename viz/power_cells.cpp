@@ -281,38 +281,47 @@ double face_area(const std::vector<Vec3>& f) {
   return 0.5 * a.norm();
 }
 
-std::vector<PowerCell> power_cells(const std::vector<Vec3>& pos, const std::vector<double>& radius,
-                                   const ClipShape& clip_shape) {
-  const int dim = clip_shape.dim;
-  const auto nb = power_neighbours(pos, radius, dim);
-  const std::vector<HalfSpace> outline = shape_planes(clip_shape);
-  std::vector<PowerCell> cells(pos.size());
+PowerDiagram::PowerDiagram(const std::vector<Vec3>& pos, const std::vector<double>& radius,
+                           const ClipShape& clip)
+    : pos_(pos), radius_(radius), clip_(clip),
+      neighbours_(power_neighbours(pos, radius, clip.dim)) {}
+
+std::vector<PowerCell> PowerDiagram::cells(std::size_t first, std::size_t last) const {
+  const std::vector<HalfSpace> outline = shape_planes(clip_);
+  last = std::min(last, pos_.size());
+  std::vector<PowerCell> cells(last > first ? last - first : 0);
 #pragma omp parallel for schedule(dynamic, 64)
-  for (std::size_t i = 0; i < pos.size(); ++i) {
-    if (nb[i].empty() && pos.size() > 1)
+  for (std::size_t i = first; i < last; ++i) {
+    const std::vector<std::size_t>& nb = neighbours_[i];
+    if (nb.empty() && pos_.size() > 1)
       continue; // hidden: an empty cell
-    if (dim == 2) {
+    if (clip_.dim == 2) {
       Polygon p;
-      const Vec3 &lo = clip_shape.lo, &hi = clip_shape.hi;
+      const Vec3 &lo = clip_.lo, &hi = clip_.hi;
       p.v = {Vec3(lo.x(), lo.y(), 0), Vec3(hi.x(), lo.y(), 0), Vec3(hi.x(), hi.y(), 0),
              Vec3(lo.x(), hi.y(), 0)};
       p.tag = {-1, -1, -1, -1};
-      for (const std::size_t j : nb[i])
-        clip(p, radical(pos[i], radius[i], pos[j], radius[j], static_cast<std::int64_t>(j)));
+      for (const std::size_t j : nb)
+        clip(p, radical(pos_[i], radius_[i], pos_[j], radius_[j], static_cast<std::int64_t>(j)));
       for (const HalfSpace& h : outline)
         clip(p, h);
-      cells[i] = cell_2d(std::move(p));
+      cells[i - first] = cell_2d(std::move(p));
     } else {
-      PowerCell c = box_cell(clip_shape.lo, clip_shape.hi);
-      for (const std::size_t j : nb[i])
-        clip(c, radical(pos[i], radius[i], pos[j], radius[j], static_cast<std::int64_t>(j)));
+      PowerCell c = box_cell(clip_.lo, clip_.hi);
+      for (const std::size_t j : nb)
+        clip(c, radical(pos_[i], radius_[i], pos_[j], radius_[j], static_cast<std::int64_t>(j)));
       for (const HalfSpace& h : outline)
         clip(c, h);
       finish_3d(c);
-      cells[i] = std::move(c);
+      cells[i - first] = std::move(c);
     }
   }
   return cells;
+}
+
+std::vector<PowerCell> power_cells(const std::vector<Vec3>& pos, const std::vector<double>& radius,
+                                   const ClipShape& clip_shape) {
+  return PowerDiagram(pos, radius, clip_shape).cells(0, pos.size());
 }
 
 } // namespace rocklab

@@ -3,7 +3,15 @@
 #include "viz/vtk_output.hpp"
 #include "viz/vtk_write.hpp"
 
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
+#include <vtkObjectFactory.h>
 #include <vtkPointData.h>
+#include <vtkPolyDataAlgorithm.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+
+#include <algorithm>
+#include <functional>
 
 #include <map>
 
@@ -121,9 +129,10 @@ FrameGrains read_grains(const std::filesystem::path& file) {
 // The cells: 3D every face of every cell (so each grain is a closed polyhedron), 2D one polygon
 // per cell; each carries its grain's index, id, cell volume, whether it lies on the specimen's
 // boundary, and the grain's scalar fields (stresses, bond damage, ...).
-void write_cells(const std::vector<PowerCell>& cells, const FrameGrains& g, const Snapshot& frame,
-                 const std::filesystem::path& path) {
-  PolyBuilder b;
+// One range of grains' cells as polygons (3D: each face; 2D: the cell polygon), with each face
+// carrying its grain's index and fields.
+void add_cells(PolyBuilder& b, const std::vector<PowerCell>& cells, std::size_t first,
+               const FrameGrains& g, const Snapshot& frame) {
   add_frame_fields(b.pd, frame);
   std::vector<std::int32_t> grain, boundary;
   std::vector<double> volume;
@@ -134,7 +143,7 @@ void write_cells(const std::vector<PowerCell>& cells, const FrameGrains& g, cons
       for (const Vec3& x : poly)
         ids.push_back(b.point(x));
       b.cells->InsertNextCell(static_cast<vtkIdType>(ids.size()), ids.data());
-      grain.push_back(static_cast<std::int32_t>(i));
+      grain.push_back(static_cast<std::int32_t>(first + i));
       boundary.push_back(on_boundary);
       volume.push_back(c.volume);
     };
@@ -158,7 +167,77 @@ void write_cells(const std::vector<PowerCell>& cells, const FrameGrains& g, cons
       v.push_back(values[static_cast<std::size_t>(i)]);
     b.cell_array<double, vtkDoubleArray>(name.c_str(), v);
   }
-  b.write(path, false);
+  b.finish(false);
+}
+
+// A VTK source whose output is the piece the writer asks for: the cells file is then written a
+// piece at a time, and only one piece's cells and polygons are in memory at once.
+class PieceSource : public vtkPolyDataAlgorithm {
+public:
+  static PieceSource* New();
+  vtkTypeMacro(PieceSource, vtkPolyDataAlgorithm)
+      std::function<void(int piece, int pieces, vtkPolyData* out)> make;
+
+protected:
+  PieceSource() { SetNumberOfInputPorts(0); }
+  int RequestInformation(vtkInformation*, vtkInformationVector**,
+                         vtkInformationVector* out) override {
+    out->GetInformationObject(0)->Set(CAN_HANDLE_PIECE_REQUEST(), 1);
+    return 1;
+  }
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override {
+    vtkInformation* info = out->GetInformationObject(0);
+    make(info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()),
+         info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()),
+         vtkPolyData::GetData(info));
+    return 1;
+  }
+};
+vtkStandardNewMacro(PieceSource)
+
+    // The cells of one frame, written in pieces of `per_piece` grains; fills each contact crack's
+    // face (the face its two grains' cells share) and the summary on the way.
+    void write_cells(const PowerDiagram& diagram, const FrameGrains& g, const Snapshot& frame,
+                     std::size_t per_piece, std::vector<std::vector<Vec3>>& faces, CellSummary& sum,
+                     const std::filesystem::path& path) {
+  const std::size_t n = diagram.size();
+  // contact cracks by the point index of their first grain
+  std::vector<std::pair<std::int64_t, std::size_t>> owned;
+  for (std::size_t k = 0; k < frame.contact_cracks.size() && k < frame.contact_crack_grains.size();
+       ++k) {
+    const auto a = g.index.find(frame.contact_crack_grains[k][0]);
+    const auto b = g.index.find(frame.contact_crack_grains[k][1]);
+    if (a != g.index.end() && b != g.index.end())
+      owned.emplace_back(a->second, k);
+  }
+  std::sort(owned.begin(), owned.end());
+  const int pieces = static_cast<int>(std::max<std::size_t>(1, (n + per_piece - 1) / per_piece));
+  std::vector<double> volume(n, 0.0); // summed in grain order below, as one pass would
+  std::vector<char> hidden(n, 0);
+  vtkNew<PieceSource> source;
+  source->make = [&](int piece, int count, vtkPolyData* out) {
+    const std::size_t first = n * static_cast<std::size_t>(piece) / static_cast<std::size_t>(count);
+    const std::size_t last =
+        n * static_cast<std::size_t>(piece + 1) / static_cast<std::size_t>(count);
+    const std::vector<PowerCell> cells = diagram.cells(first, last);
+    PolyBuilder b;
+    add_cells(b, cells, first, g, frame);
+    out->ShallowCopy(b.pd);
+    for (std::size_t i = 0; i < cells.size(); ++i)
+      volume[first + i] = cells[i].volume, hidden[first + i] = cells[i].faces.empty();
+    auto it = std::lower_bound(owned.begin(), owned.end(),
+                               std::pair{static_cast<std::int64_t>(first), std::size_t{0}});
+    for (; it != owned.end() && it->first < static_cast<std::int64_t>(last); ++it) {
+      const std::size_t k = it->second;
+      const std::int64_t other = g.index.at(frame.contact_crack_grains[k][1]);
+      const auto* f = cells[static_cast<std::size_t>(it->first) - first].face_with(other);
+      faces[k] = f ? *f : std::vector<Vec3>{};
+    }
+  };
+  write_xml<vtkXMLPolyDataWriter>(nullptr, path, source, pieces);
+  sum.grains = n;
+  for (std::size_t i = 0; i < n; ++i)
+    sum.volume_sum += volume[i], sum.hidden += static_cast<std::size_t>(hidden[i]);
 }
 
 } // namespace
@@ -185,33 +264,20 @@ CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at
       shape.lo = Vec3(v[1], v[2], v[3]), shape.hi = Vec3(v[4], v[5], v[6]);
       shape.center = Vec3(v[7], v[8], 0), shape.radius = v[9];
     }
-    const std::vector<PowerCell> cells =
-        with_cells ? power_cells(g.info.positions, radius, shape) : std::vector<PowerCell>{};
-    if (with_cells)
-      write_cells(cells, g, s, dir_ / ("cells_" + index + ".vtp"));
     // each contact crack as its grains' shared face, where their cells touch
     std::vector<std::vector<Vec3>> faces(s.contact_cracks.size());
-    std::size_t faced = 0;
-    for (std::size_t k = 0; k < s.contact_cracks.size() && k < s.contact_crack_grains.size(); ++k) {
-      const auto a = g.index.find(s.contact_crack_grains[k][0]);
-      const auto b = g.index.find(s.contact_crack_grains[k][1]);
-      if (a == g.index.end() || b == g.index.end() || cells.empty())
-        continue;
-      if (const auto* f = cells[static_cast<std::size_t>(a->second)].face_with(b->second)) {
-        faces[k] = *f;
-        ++faced;
-      }
-    }
+    CellSummary cell_sum;
+    if (with_cells)
+      write_cells(PowerDiagram(g.info.positions, radius, shape), g, s, cell_piece_grains_, faces,
+                  cell_sum, dir_ / ("cells_" + index + ".vtp"));
     write_cracks(s.contact_cracks, s, true, dir_ / ("contact_cracks_" + index + ".vtp"), &faces);
     write_events(s.events, s, dir_ / ("events_" + index + ".vtp"));
     if (tagged_.contains(index))
       continue; // the summary is of the last numbered snapshot (the end of the test)
-    sum = {};
-    sum.grains = cells.size();
-    for (const PowerCell& c : cells)
-      sum.volume_sum += c.volume, sum.hidden += c.faces.empty();
+    sum = cell_sum;
     sum.shape_volume = with_cells ? shape.volume() : 0.0;
-    sum.faced_cracks = faced;
+    sum.faced_cracks = static_cast<std::size_t>(
+        std::count_if(faces.begin(), faces.end(), [](const auto& f) { return !f.empty(); }));
     sum.contact_cracks = s.contact_cracks.size();
   }
   fractures_ = true;

@@ -121,6 +121,9 @@ public:
   /// grains, events and round). Returns what the last frame's cells measured. Without
   /// `with_cells` no cells are made and the contact cracks are disks.
   CellSummary write_fractures(const std::function<Snapshot(double)>& at, bool with_cells = true);
+  /// Grains per piece of a cells file: the cells are made and written one piece at a time, so
+  /// that a large packing's cells are never all in memory (default 1024).
+  void set_cell_piece_grains(std::size_t n) { cell_piece_grains_ = n > 0 ? n : 1; }
   /// Write the .pvd collections (time = model time); returns their names.
   std::vector<std::string> write_collections() const;
   int count() const { return static_cast<int>(times_.size()); }
@@ -136,6 +139,7 @@ private:
   std::vector<double> times_;
   std::map<std::string, double> tagged_;
   bool fractures_ = false, cells_ = false;
+  std::size_t cell_piece_grains_ = 1024;
   /// (file index, time) of every snapshot written: the numbered ones in order, then the tagged.
   std::vector<std::pair<std::string, double>> snapshot_files() const;
 };

@@ -44,11 +44,20 @@ template <class T, class Arr> vtkNew<Arr> scalar_array(const char* name, const s
 }
 
 // One VTK XML file (appended raw data); a failed write is our OutputError, not VTK's log.
-template <class Writer> void write_xml(vtkDataObject* data, const std::filesystem::path& p) {
+// `pieces` > 1 streams the data from `source` one piece at a time (the source makes each piece
+// when the writer asks for it), so only one piece is in memory at once.
+template <class Writer>
+void write_xml(vtkDataObject* data, const std::filesystem::path& p, vtkAlgorithm* source = nullptr,
+               int pieces = 1) {
   vtkObject::GlobalWarningDisplayOff();
   vtkNew<Writer> w;
   w->SetFileName(p.string().c_str());
-  w->SetInputData(data);
+  if (source) {
+    w->SetInputConnection(source->GetOutputPort());
+    w->SetNumberOfPieces(pieces);
+  } else {
+    w->SetInputData(data);
+  }
   w->SetDataModeToAppended();
   w->EncodeAppendedDataOff();
   if (w->Write() != 1)
@@ -74,12 +83,15 @@ struct PolyBuilder {
   PolyBuilder() { pts->SetDataTypeToDouble(); }
   vtkIdType point(const Vec3& x) { return pts->InsertNextPoint(x.x(), x.y(), x.z()); }
   /// The cells are lines (2D pictures, bonds) or polygons.
-  void write(const std::filesystem::path& path, bool as_lines) {
+  void finish(bool as_lines) {
     pd->SetPoints(pts);
     if (as_lines)
       pd->SetLines(cells);
     else
       pd->SetPolys(cells);
+  }
+  void write(const std::filesystem::path& path, bool as_lines) {
+    finish(as_lines);
     write_poly(pd, path);
   }
   template <class T, class Arr> void cell_array(const char* name, const std::vector<T>& v) {

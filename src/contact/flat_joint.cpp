@@ -296,6 +296,21 @@ void ElementStep::run(FlatJointElement& el) {
   shear(el, bonded, sigma);
 }
 
+// The smallest gap over the interface, gs - R |tb|, is not negative (section 1.6). Decided by
+// squares where they settle it with a margin far above round-off, so that the costly libm hypot
+// (7 % of a flat-jointed UCS cycle, on every unbonded contact) runs only near equality, where it
+// gives the same answer as before to the bit.
+bool open_everywhere(double gs, double R, double tbs, double tbt) {
+  if (gs < 0)
+    return false;
+  const double a = gs * gs, b = R * R * (tbs * tbs + tbt * tbt);
+  if (a > b * (1 + 1e-12))
+    return true;
+  if (a < b * (1 - 1e-12))
+    return false;
+  return gs - R * std::hypot(tbs, tbt) >= 0;
+}
+
 } // namespace
 
 void FlatJoint::update(Contact& c, Elements e, const ContactKinematics& k, ContactResult& out,
@@ -319,8 +334,8 @@ void FlatJoint::update(Contact& c, Elements e, const ContactKinematics& k, Conta
   bool any_bonded = false;
   for (const auto& el : e)
     any_bonded = any_bonded || el.B == BondState::Bonded;
-  // The smallest gap over the interface (only read without bonds: hypot is a costly libm call).
-  if (!any_bonded && c.gs - R * std::hypot(c.tbs, c.tbt) >= 0) {
+  // Without bonds, an interface whose smallest gap is not negative carries nothing.
+  if (!any_bonded && open_everywhere(c.gs, R, c.tbs, c.tbt)) {
     for (auto& el : e) {
       if (el.slip)
         events.slip_change(false, static_cast<std::int32_t>(&el - e.data()) + 1);

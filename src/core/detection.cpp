@@ -175,6 +175,15 @@ void Model::gather_candidates(const CellGrid& g) {
     candidate_keys_.insert(candidate_keys_.end(), keys.begin(), keys.end());
 }
 
+void Model::release_scratch() {
+  std::vector<Contact>().swap(new_contacts_);
+  std::vector<ContactOutput>().swap(new_outputs_);
+  new_batches_ = ModelBatches{};
+  std::vector<std::uint64_t>().swap(candidate_keys_);
+  for (auto& keys : thread_keys_)
+    std::vector<std::uint64_t>().swap(keys);
+}
+
 void Model::reserve_lists() {
   reserve_with_slack(new_contacts_, contacts_.size());
   reserve_with_slack(new_outputs_, contacts_.size());
