@@ -366,15 +366,22 @@ void JsonObject::finish() const {
   }
 }
 
-std::string text_hash(std::string_view text) {
-  std::uint64_t h = 1469598103934665603ULL;
+std::uint64_t fnv1a64(std::string_view text, std::uint64_t h) {
   for (unsigned char c : text) {
     h ^= c;
     h *= 1099511628211ULL;
   }
+  return h;
+}
+
+std::string hash_hex(std::uint64_t h) {
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
   return buf;
+}
+
+std::string text_hash(std::string_view text) {
+  return hash_hex(fnv1a64(text));
 }
 
 } // namespace rocklab

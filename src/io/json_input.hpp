@@ -46,6 +46,11 @@ nlohmann::json read_json_file(const std::string& path, Nulls nulls = Nulls::Reje
 /// FNV-1a 64-bit hash of bytes, as 16 hex digits (stable across platforms): input texts for the
 /// caches, specimen and checkpoint bodies for their checksum. Any single changed byte changes it.
 std::string text_hash(std::string_view text);
+/// The FNV-1a 64 hash of `text` continued from `h` (text_hash is its start, in 16 hex digits):
+/// for hashing a long text a piece at a time.
+std::uint64_t fnv1a64(std::string_view text, std::uint64_t h = 1469598103934665603ULL);
+/// A hash as text_hash prints it.
+std::string hash_hex(std::uint64_t h);
 
 /// A JSON object being read: tracks the keys used so unknown keys can be reported.
 class JsonObject {
