@@ -126,11 +126,10 @@ FrameGrains read_grains(const std::filesystem::path& file) {
   return g;
 }
 
-// The cells: 3D every face of every cell (so each grain is a closed polyhedron), 2D one polygon
-// per cell; each carries its grain's index, id, cell volume, whether it lies on the specimen's
-// boundary, and the grain's scalar fields (stresses, bond damage, ...).
-// One range of grains' cells as polygons (3D: each face; 2D: the cell polygon), with each face
-// carrying its grain's index and fields.
+// The cells of grains [first, first + cells.size()): 3D every face of every cell (so each grain
+// is a closed polyhedron), 2D one polygon per cell; each carries its grain's index, id, cell
+// volume, whether it lies on the specimen's boundary, and the grain's scalar fields (stresses,
+// bond damage, ...).
 void add_cells(PolyBuilder& b, const std::vector<PowerCell>& cells, std::size_t first,
                const FrameGrains& g, const Snapshot& frame) {
   add_frame_fields(b.pd, frame);
@@ -176,7 +175,7 @@ class PieceSource : public vtkPolyDataAlgorithm {
 public:
   static PieceSource* New();
   vtkTypeMacro(PieceSource, vtkPolyDataAlgorithm)
-      std::function<void(int piece, int pieces, vtkPolyData* out)> make;
+  std::function<void(int piece, int pieces, vtkPolyData* out)> make;
 
 protected:
   PieceSource() { SetNumberOfInputPorts(0); }
@@ -195,11 +194,11 @@ protected:
 };
 vtkStandardNewMacro(PieceSource)
 
-    // The cells of one frame, written in pieces of `per_piece` grains; fills each contact crack's
-    // face (the face its two grains' cells share) and the summary on the way.
-    void write_cells(const PowerDiagram& diagram, const FrameGrains& g, const Snapshot& frame,
-                     std::size_t per_piece, std::vector<std::vector<Vec3>>& faces, CellSummary& sum,
-                     const std::filesystem::path& path) {
+// The cells of one frame, written in pieces of `per_piece` grains; fills each contact crack's
+// face (the face its two grains' cells share) and the summary on the way.
+void write_cells(const PowerDiagram& diagram, const FrameGrains& g, const Snapshot& frame,
+                 std::size_t per_piece, std::vector<std::vector<Vec3>>& faces, CellSummary& sum,
+                 const std::filesystem::path& path) {
   const std::size_t n = diagram.size();
   // contact cracks by the point index of their first grain
   std::vector<std::pair<std::int64_t, std::size_t>> owned;
