@@ -158,3 +158,27 @@ TEST(VtkCells, APiecewiseCellsFileEqualsTheWholeOne) {
   EXPECT_EQ(seven.sum.faced_cracks, one.sum.faced_cracks);
   EXPECT_EQ(seven.faces.positions, one.faces.positions);
 }
+
+// The crack series is written 4,096 cracks a piece: 10,000 disks come back whole and in order.
+TEST(VtkCells, ACrackFileOfManyPiecesHoldsEveryCrackInOrder) {
+  Snapshot frame;
+  frame.dim = 3;
+  frame.cracks.resize(10000);
+  for (std::size_t k = 0; k < frame.cracks.size(); ++k) {
+    frame.cracks[k].position = Vec3(1e-6 * static_cast<double>(k), 0, 0);
+    frame.cracks[k].size = 1e-4;
+    frame.cracks[k].time = static_cast<double>(k);
+  }
+  const fs::path dir = test::scratch_root() / "vtk-many-cracks";
+  fs::remove_all(dir);
+  VtkSeries(dir).write(frame);
+  const fs::path file = dir / "cracks_0000.vtp";
+  const VtkFileInfo v = read_vtk_info(file.string());
+  ASSERT_EQ(v.cells, 10000);
+  EXPECT_EQ(v.points, 16 * 10000);
+  const std::vector<double>& time = v.cell_values.at("time");
+  ASSERT_EQ(time.size(), 10000u);
+  for (std::size_t k = 0; k < time.size(); ++k)
+    ASSERT_EQ(time[k], static_cast<double>(k)) << k;
+  EXPECT_NEAR(v.positions.back().x(), 1e-6 * 9999, 1e-4); // the last disk's rim
+}

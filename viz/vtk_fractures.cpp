@@ -19,16 +19,62 @@ namespace rocklab {
 
 namespace vtkw {
 
-// Cracks: 3D disks as 16-gons, 2D segments in the xy plane; per-contact cracks with their damage,
-// event and energy.
-void write_cracks(const std::vector<CrackGlyph>& cracks, const Snapshot& frame, bool per_contact,
-                  const std::filesystem::path& path, const std::vector<std::vector<Vec3>>* faces) {
+namespace {
+
+// A VTK source whose output is the piece the writer asks for: a file is then written a piece at
+// a time, and only one piece's polygons are in memory at once.
+class PieceSource : public vtkPolyDataAlgorithm {
+public:
+  static PieceSource* New();
+  vtkTypeMacro(PieceSource, vtkPolyDataAlgorithm)
+  std::function<void(int piece, int pieces, vtkPolyData* out)> make;
+
+protected:
+  PieceSource() { SetNumberOfInputPorts(0); }
+  int RequestInformation(vtkInformation*, vtkInformationVector**,
+                         vtkInformationVector* out) override {
+    out->GetInformationObject(0)->Set(CAN_HANDLE_PIECE_REQUEST(), 1);
+    return 1;
+  }
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override {
+    vtkInformation* info = out->GetInformationObject(0);
+    make(info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()),
+         info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()),
+         vtkPolyData::GetData(info));
+    return 1;
+  }
+};
+vtkStandardNewMacro(PieceSource)
+
+} // namespace
+
+void write_poly_pieces(const std::filesystem::path& path, std::size_t items, std::size_t per_piece,
+                       const std::function<void(std::size_t, std::size_t, PolyBuilder&)>& make) {
+  per_piece = std::max<std::size_t>(per_piece, 1);
+  const int pieces =
+      static_cast<int>(std::max<std::size_t>(1, (items + per_piece - 1) / per_piece));
+  vtkNew<PieceSource> source;
+  source->make = [&](int piece, int count, vtkPolyData* out) {
+    const auto at = [&](int p) {
+      return items * static_cast<std::size_t>(p) / static_cast<std::size_t>(count);
+    };
+    PolyBuilder b;
+    make(at(piece), at(piece + 1), b);
+    out->ShallowCopy(b.pd);
+  };
+  write_xml<vtkXMLPolyDataWriter>(nullptr, path, source, pieces);
+}
+
+// Cracks [first, last) into b: 3D disks as 16-gons (or the given faces), 2D segments in the xy
+// plane; per-contact cracks with their damage, event and energy.
+void add_cracks(PolyBuilder& b, const std::vector<CrackGlyph>& cracks, std::size_t first,
+                std::size_t last, const Snapshot& frame, bool per_contact,
+                const std::vector<std::vector<Vec3>>* faces) {
   const int dim = frame.dim;
-  PolyBuilder b;
   add_frame_fields(b.pd, frame);
   std::vector<std::int32_t> mode, event, faced;
   std::vector<double> time, size, damage, energy;
-  for (std::size_t k = 0; k < cracks.size(); ++k) {
+  for (std::size_t k = first; k < last; ++k) {
     const CrackGlyph& c = cracks[k];
     const double r = 0.5 * c.size;
     const std::vector<Vec3>* face =
@@ -48,9 +94,9 @@ void write_cracks(const std::vector<CrackGlyph>& cracks, const Snapshot& frame, 
       plane_axes(c.normal, u, v);
       constexpr int kSides = 16;
       vtkIdType ids[kSides];
-      for (int k = 0; k < kSides; ++k) {
-        const double a = 2 * kPi * k / kSides;
-        ids[k] = b.point(c.position + r * (std::cos(a) * u + std::sin(a) * v));
+      for (int side = 0; side < kSides; ++side) {
+        const double a = 2 * kPi * side / kSides;
+        ids[side] = b.point(c.position + r * (std::cos(a) * u + std::sin(a) * v));
       }
       b.cells->InsertNextCell(kSides, ids);
     }
@@ -71,7 +117,17 @@ void write_cracks(const std::vector<CrackGlyph>& cracks, const Snapshot& frame, 
     if (faces)
       b.cell_array<std::int32_t, vtkIntArray>("faced", faced);
   }
-  b.write(path, dim == 2);
+  b.finish(dim == 2);
+}
+
+// Cracks: 3D disks as 16-gons, 2D segments in the xy plane; per-contact cracks with their damage,
+// event and energy.
+void write_cracks(const std::vector<CrackGlyph>& cracks, const Snapshot& frame, bool per_contact,
+                  const std::filesystem::path& path, const std::vector<std::vector<Vec3>>* faces) {
+  write_poly_pieces(path, cracks.size(), 4096,
+                    [&](std::size_t first, std::size_t last, PolyBuilder& b) {
+                      add_cracks(b, cracks, first, last, frame, per_contact, faces);
+                    });
 }
 
 // Fracture events: one vertex per event at the centroid of its cracks.
@@ -169,31 +225,6 @@ void add_cells(PolyBuilder& b, const std::vector<PowerCell>& cells, std::size_t 
   b.finish(false);
 }
 
-// A VTK source whose output is the piece the writer asks for: the cells file is then written a
-// piece at a time, and only one piece's cells and polygons are in memory at once.
-class PieceSource : public vtkPolyDataAlgorithm {
-public:
-  static PieceSource* New();
-  vtkTypeMacro(PieceSource, vtkPolyDataAlgorithm)
-  std::function<void(int piece, int pieces, vtkPolyData* out)> make;
-
-protected:
-  PieceSource() { SetNumberOfInputPorts(0); }
-  int RequestInformation(vtkInformation*, vtkInformationVector**,
-                         vtkInformationVector* out) override {
-    out->GetInformationObject(0)->Set(CAN_HANDLE_PIECE_REQUEST(), 1);
-    return 1;
-  }
-  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector* out) override {
-    vtkInformation* info = out->GetInformationObject(0);
-    make(info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_PIECE_NUMBER()),
-         info->Get(vtkStreamingDemandDrivenPipeline::UPDATE_NUMBER_OF_PIECES()),
-         vtkPolyData::GetData(info));
-    return 1;
-  }
-};
-vtkStandardNewMacro(PieceSource)
-
 // The cells of one frame, written in pieces of `per_piece` grains; fills each contact crack's
 // face (the face its two grains' cells share) and the summary on the way.
 void write_cells(const PowerDiagram& diagram, const FrameGrains& g, const Snapshot& frame,
@@ -210,18 +241,11 @@ void write_cells(const PowerDiagram& diagram, const FrameGrains& g, const Snapsh
       owned.emplace_back(a->second, k);
   }
   std::sort(owned.begin(), owned.end());
-  const int pieces = static_cast<int>(std::max<std::size_t>(1, (n + per_piece - 1) / per_piece));
   std::vector<double> volume(n, 0.0); // summed in grain order below, as one pass would
   std::vector<char> hidden(n, 0);
-  vtkNew<PieceSource> source;
-  source->make = [&](int piece, int count, vtkPolyData* out) {
-    const std::size_t first = n * static_cast<std::size_t>(piece) / static_cast<std::size_t>(count);
-    const std::size_t last =
-        n * static_cast<std::size_t>(piece + 1) / static_cast<std::size_t>(count);
+  write_poly_pieces(path, n, per_piece, [&](std::size_t first, std::size_t last, PolyBuilder& b) {
     const std::vector<PowerCell> cells = diagram.cells(first, last);
-    PolyBuilder b;
     add_cells(b, cells, first, g, frame);
-    out->ShallowCopy(b.pd);
     for (std::size_t i = 0; i < cells.size(); ++i)
       volume[first + i] = cells[i].volume, hidden[first + i] = cells[i].faces.empty();
     auto it = std::lower_bound(owned.begin(), owned.end(),
@@ -232,8 +256,7 @@ void write_cells(const PowerDiagram& diagram, const FrameGrains& g, const Snapsh
       const auto* f = cells[static_cast<std::size_t>(it->first) - first].face_with(other);
       faces[k] = f ? *f : std::vector<Vec3>{};
     }
-  };
-  write_xml<vtkXMLPolyDataWriter>(nullptr, path, source, pieces);
+  });
   sum.grains = n;
   for (std::size_t i = 0; i < n; ++i)
     sum.volume_sum += volume[i], sum.hidden += static_cast<std::size_t>(hidden[i]);

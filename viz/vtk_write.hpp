@@ -17,6 +17,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <numbers>
 #include <vector>
 
@@ -114,8 +115,15 @@ inline void add_frame_fields(vtkDataObject* d, const Snapshot& s) {
   }
 }
 
+/// One polydata file of `items` things written `per_piece` at a time: `make(first, last, b)` fills
+/// builder b with items [first, last) (b.finish included), and only one piece is in memory at
+/// once, made when VTK's writer asks for it (vtk_fractures.cpp). At 10k grains the power cells
+/// and their polygons were 75 MB at once.
+void write_poly_pieces(const std::filesystem::path& path, std::size_t items, std::size_t per_piece,
+                       const std::function<void(std::size_t, std::size_t, PolyBuilder&)>& make);
+
 /// Cracks: 3D disks (or the given polygons), 2D segments; per-contact cracks carry their damage,
-/// event and energy (vtk_fractures.cpp).
+/// event and energy (vtk_fractures.cpp). Written 4,096 cracks a piece.
 void write_cracks(const std::vector<CrackGlyph>& cracks, const Snapshot& frame, bool per_contact,
                   const std::filesystem::path& path,
                   const std::vector<std::vector<Vec3>>* faces = nullptr);
