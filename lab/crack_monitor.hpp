@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -36,7 +37,7 @@ public:
   std::int64_t shear() const { return shear_; }
   std::int64_t total() const { return static_cast<std::int64_t>(cracks_.size()); }
   /// cracks.csv: one row per crack, SI units.
-  std::string csv() const;
+  void write_csv(std::ostream& out) const;
   nlohmann::json to_json() const; ///< for checkpoints
   void from_json(const nlohmann::json& j);
 

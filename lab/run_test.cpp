@@ -333,7 +333,7 @@ void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::t
                      {"threads", omp_get_max_threads()},
                      {"wall_time_s", sum.wall_seconds}};
   write_text_file(out.staged("history.csv"), f.history_csv());
-  write_text_file(out.staged("cracks.csv"), f.cracks().csv());
+  write_file(out.staged("cracks.csv"), [&](std::ostream& o) { f.cracks().write_csv(o); });
   write_text_file(out.staged("events.csv"), events_csv(ev.events));
   sum.files.insert(sum.files.end(), {"results.json", "history.csv", "cracks.csv", "events.csv"});
   if (p.plots)
