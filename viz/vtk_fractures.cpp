@@ -14,6 +14,7 @@
 #include <functional>
 
 #include <map>
+#include <tuple>
 
 namespace rocklab {
 
@@ -231,14 +232,15 @@ void write_cells(const PowerDiagram& diagram, const FrameGrains& g, const Snapsh
                  std::size_t per_piece, std::vector<std::vector<Vec3>>& faces, CellSummary& sum,
                  const std::filesystem::path& path) {
   const std::size_t n = diagram.size();
-  // contact cracks by the point index of their first grain
-  std::vector<std::pair<std::int64_t, std::size_t>> owned;
+  // contact cracks as (point index of the first grain, crack, point index of the second), by the
+  // first grain
+  std::vector<std::tuple<std::int64_t, std::size_t, std::int64_t>> owned;
   for (std::size_t k = 0; k < frame.contact_cracks.size() && k < frame.contact_crack_grains.size();
        ++k) {
     const auto a = g.index.find(frame.contact_crack_grains[k][0]);
     const auto b = g.index.find(frame.contact_crack_grains[k][1]);
     if (a != g.index.end() && b != g.index.end())
-      owned.emplace_back(a->second, k);
+      owned.emplace_back(a->second, k, b->second);
   }
   std::sort(owned.begin(), owned.end());
   std::vector<double> volume(n, 0.0); // summed in grain order below, as one pass would
@@ -248,13 +250,12 @@ void write_cells(const PowerDiagram& diagram, const FrameGrains& g, const Snapsh
     add_cells(b, cells, first, g, frame);
     for (std::size_t i = 0; i < cells.size(); ++i)
       volume[first + i] = cells[i].volume, hidden[first + i] = cells[i].faces.empty();
-    auto it = std::lower_bound(owned.begin(), owned.end(),
-                               std::pair{static_cast<std::int64_t>(first), std::size_t{0}});
-    for (; it != owned.end() && it->first < static_cast<std::int64_t>(last); ++it) {
-      const std::size_t k = it->second;
-      const std::int64_t other = g.index.at(frame.contact_crack_grains[k][1]);
-      const auto* f = cells[static_cast<std::size_t>(it->first) - first].face_with(other);
-      faces[k] = f ? *f : std::vector<Vec3>{};
+    const auto from = std::tuple{static_cast<std::int64_t>(first), std::size_t{0}, std::int64_t{0}};
+    for (auto it = std::lower_bound(owned.begin(), owned.end(), from);
+         it != owned.end() && std::get<0>(*it) < static_cast<std::int64_t>(last); ++it) {
+      const auto [a, k, other] = *it;
+      if (const auto* f = cells[static_cast<std::size_t>(a) - first].face_with(other))
+        faces[k] = *f;
     }
   });
   sum.grains = n;

@@ -123,7 +123,7 @@ public:
   CellSummary write_fractures(const std::function<Snapshot(double)>& at, bool with_cells = true);
   /// Grains per piece of a cells file: the cells are made and written one piece at a time, so
   /// that a large packing's cells are never all in memory (default 1024).
-  void set_cell_piece_grains(std::size_t n) { cell_piece_grains_ = n > 0 ? n : 1; }
+  void set_cell_piece_grains(std::size_t n) { cell_piece_grains_ = n; }
   /// Write the .pvd collections (time = model time); returns their names.
   std::vector<std::string> write_collections() const;
   int count() const { return static_cast<int>(times_.size()); }
