@@ -1,4 +1,5 @@
 // Specimen / checkpoint files: exact restore, deterministic bytes, clean failures.
+#include "contact/model_json.hpp"
 #include "helpers.hpp"
 #include "io/json_input.hpp"
 #include "io/results.hpp"
@@ -7,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -65,6 +67,132 @@ std::unique_ptr<Model> busy_model() {
   return std::move(s.model);
 }
 } // namespace
+
+namespace {
+/// Each contact's model state (results.json's "state") and output by key.
+std::map<std::uint64_t, std::string> contact_states(const Model& m) {
+  std::map<std::uint64_t, std::string> out;
+  for (std::size_t i = 0; i < m.contacts().size(); ++i) {
+    const Contact& c = m.contacts()[i];
+    const ContactOutput& o = m.contact_outputs()[i];
+    std::ostringstream s;
+    s.precision(17);
+    s << model_name(c.model) << " " << o.xc.transpose() << " " << o.force.transpose() << " "
+      << contact_state_json(m.batches(), c.model, c.slot, m.settings.dim).dump();
+    out[c.key] = s.str();
+  }
+  return out;
+}
+
+/// Every model's slots count up from 0 in contact order, its batch holds nothing else, and the
+/// flat joints' elements lie in slot order without holes.
+::testing::AssertionResult packed(const Model& m) {
+  std::array<std::uint32_t, kModelCount> next{};
+  for (std::size_t i = 0; i < m.contacts().size(); ++i) {
+    const Contact& c = m.contacts()[i];
+    if (c.slot != next[static_cast<std::size_t>(c.model)]++)
+      return ::testing::AssertionFailure() << "contact " << i << " has slot " << c.slot;
+  }
+  std::string bad;
+  for_each_model([&]<class M>() {
+    if (m.batches().of<M>().contacts.size() != next[static_cast<std::size_t>(model_kind<M>)])
+      bad += std::string(M::name) + ": slots left over; ";
+  });
+  const Batch<FlatJoint>& fj = m.batches().of<FlatJoint>();
+  if (!fj.pool.packed(fj.contacts))
+    bad += "flat-joint elements not packed";
+  if (!bad.empty())
+    return ::testing::AssertionFailure() << bad;
+  return ::testing::AssertionSuccess();
+}
+
+std::array<std::size_t, kModelCount> per_model(const Model& m) {
+  std::array<std::size_t, kModelCount> n{};
+  for (const Contact& c : m.contacts())
+    ++n[static_cast<std::size_t>(c.model)];
+  return n;
+}
+} // namespace
+
+// The contact list is rebuilt in place at each detection (src/core/contact_list.cpp): the
+// contacts that stay keep their data bit for bit while others are added in key order or removed
+// around them, and every model's batch stays packed.
+TEST(ContactList, ARebuildInPlaceKeepsEachContactsDataAndPacksTheBatches) {
+  std::unique_ptr<Model> m = busy_model(); // 1,500 steps of detections behind it
+  EXPECT_TRUE(packed(*m));
+  const auto before = contact_states(*m);
+  const auto n_before = per_model(*m);
+  const double margin = m->margin();
+  m->set_margin(4 * margin); // contacts added between the present ones
+  EXPECT_TRUE(packed(*m));
+  const auto wide = contact_states(*m);
+  const auto n_wide = per_model(*m);
+  const std::size_t fj = static_cast<std::size_t>(model_kind<FlatJoint>);
+  EXPECT_GT(n_wide[fj], n_before[fj]);
+  for (const auto& [key, s] : before) {
+    ASSERT_TRUE(wide.count(key)) << "contact " << key << " lost";
+    EXPECT_EQ(wide.at(key), s) << "contact " << key;
+  }
+  std::size_t added_fj = 0; // the added flat joints have their own data (Eq. 30's radius)
+  for (const Contact& c : m->contacts())
+    if (c.model == model_kind<FlatJoint> && !before.count(c.key)) {
+      const auto& fjc = m->batches().of<FlatJoint>().contacts[c.slot];
+      const double R1 = m->balls.radius[static_cast<std::size_t>(c.end1)];
+      const double R2 = m->balls.radius[static_cast<std::size_t>(c.end2)];
+      EXPECT_EQ(fjc.R, fjc.rmul * std::min(R1, R2)) << "contact " << c.key;
+      ++added_fj;
+    }
+  EXPECT_GT(added_fj, 1u);
+  m->set_margin(margin); // the ones out of reach go again
+  EXPECT_TRUE(packed(*m));
+  const auto back = contact_states(*m);
+  EXPECT_LT(back.size(), wide.size());
+  for (const auto& [key, s] : back) {
+    ASSERT_TRUE(wide.count(key)) << "contact " << key << " appeared";
+    EXPECT_EQ(wide.at(key), s) << "contact " << key;
+  }
+  // Removing every fifth ball drops flat joints among the others (the pool compacted in place);
+  // the rest keep their order and data under renumbered ends.
+  std::vector<bool> remove(m->balls.size());
+  for (std::size_t i = 0; i < remove.size(); i += 5)
+    remove[i] = m->balls.clump[i] < 0;
+  std::vector<std::string> staying;
+  const auto fj_before = per_model(*m)[fj];
+  const auto present = contact_states(*m);
+  for (const Contact& c : m->contacts())
+    if (!remove[static_cast<std::size_t>(c.end1)] &&
+        (c.kind != ContactKind::BallBall || !remove[static_cast<std::size_t>(c.end2)]))
+      staying.push_back(present.at(c.key));
+  m->remove_balls(remove);
+  EXPECT_TRUE(packed(*m));
+  EXPECT_LT(per_model(*m)[fj], fj_before);
+  ASSERT_GE(m->contacts().size(), staying.size());
+  const auto after = contact_states(*m);
+  std::size_t k = 0; // remove_balls re-detects: contacts may be added, none of the old ones lost
+  for (const Contact& c : m->contacts())
+    if (k < staying.size() && after.at(c.key) == staying[k])
+      ++k;
+  EXPECT_EQ(k, staying.size());
+  // A replaced contact model leaves its old data behind; the next rebuild packs the batches.
+  LinearProps lin;
+  lin.kn = 1e5;
+  auto gap = [&](const Contact& c) { // (new contacts' gap fields are set by their first update)
+    const auto i = static_cast<std::size_t>(c.end1), j = static_cast<std::size_t>(c.end2);
+    return (m->balls.pos[i] - m->balls.pos[j]).norm() - m->balls.radius[i] - m->balls.radius[j];
+  };
+  const auto closest_fj = std::min_element(
+      m->contacts().begin(), m->contacts().end(), [&](const Contact& x, const Contact& y) {
+        const bool fx = x.model == model_kind<FlatJoint>, fy = y.model == model_kind<FlatJoint>;
+        return fx != fy ? fx : gap(x) < gap(y);
+      });
+  ASSERT_EQ(closest_fj->model, model_kind<FlatJoint>);
+  const std::uint64_t key = closest_fj->key;
+  m->replace_contact_model(static_cast<std::size_t>(closest_fj - m->contacts().begin()), lin);
+  EXPECT_FALSE(packed(*m));
+  m->set_margin(margin);
+  EXPECT_TRUE(packed(*m));
+  EXPECT_EQ(contact_states(*m).at(key).rfind("linear ", 0), 0u);
+}
 
 TEST(Specimen, RoundTripContinuesBitForBit) {
   std::unique_ptr<Model> a = busy_model();

@@ -6,6 +6,7 @@
 #include "contact/contact_model.hpp"
 #include "io/input_error.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cassert>
 #include <cstdint>
@@ -110,6 +111,52 @@ struct FlatJointElements {
     return {all.data() + c.elem, c.n_elem};
   }
   void clear() { all.clear(); }
+  std::size_t size() const { return all.size(); }
+
+  // Rebuilding the batch in place (Model::rebuild_contacts): the contacts' elements lie in slot
+  // order without holes ("packed"); kept contacts move to the front, then everything moves to
+  // its final place from the back, so no second copy of the pool is ever made.
+  bool packed(std::span<const FlatJointContact> contacts) const {
+    std::size_t at = 0;
+    for (const FlatJointContact& c : contacts) {
+      if (c.elem != at)
+        return false;
+      at += c.n_elem;
+    }
+    return at == all.size();
+  }
+  /// Move c's elements to start at `at` (<= where they are); returns the index after them.
+  std::size_t pack_to(FlatJointContact& c, std::size_t at) {
+    assert(at <= c.elem && "elements move toward the front");
+    if (at != c.elem)
+      std::move(all.begin() + c.elem, all.begin() + c.elem + c.n_elem, all.begin() + at);
+    c.elem = static_cast<std::uint32_t>(at);
+    return at + c.n_elem;
+  }
+  /// Grow or shrink to n elements (capacity for n and 1/16 more when it grows).
+  void resize(std::size_t n) {
+    if (all.capacity() < n)
+      all.reserve(n + n / 16 + 64);
+    all.resize(n);
+  }
+  /// Move c's elements to end at `end` (their end <= `end`); returns where they now start.
+  std::size_t place_before(FlatJointContact& c, std::size_t end) {
+    const std::size_t at = end - c.n_elem;
+    assert(at >= c.elem && "elements move toward the back");
+    if (at != c.elem)
+      std::move_backward(all.begin() + c.elem, all.begin() + c.elem + c.n_elem,
+                         all.begin() + static_cast<std::ptrdiff_t>(end));
+    c.elem = static_cast<std::uint32_t>(at);
+    return at;
+  }
+  /// Copy c's elements from another pool to end at `end`; returns where they now start.
+  std::size_t copy_before(const FlatJointElements& from, FlatJointContact& c, std::size_t end) {
+    const auto e = from.of(c);
+    const std::size_t at = end - c.n_elem;
+    std::copy(e.begin(), e.end(), all.begin() + static_cast<std::ptrdiff_t>(at));
+    c.elem = static_cast<std::uint32_t>(at);
+    return at;
+  }
   /// Copy a contact's elements from another pool; returns the contact pointing at the copy.
   FlatJointContact adopt(const FlatJointElements& from, FlatJointContact c) {
     const auto e = from.of(c);

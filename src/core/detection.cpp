@@ -175,22 +175,9 @@ void Model::gather_candidates(const CellGrid& g) {
     candidate_keys_.insert(candidate_keys_.end(), keys.begin(), keys.end());
 }
 
-void Model::release_scratch() {
-  std::vector<Contact>().swap(new_contacts_);
-  std::vector<ContactOutput>().swap(new_outputs_);
-  new_batches_ = ModelBatches{};
-  std::vector<std::uint64_t>().swap(candidate_keys_);
-  for (auto& keys : thread_keys_)
-    std::vector<std::uint64_t>().swap(keys);
-}
-
-void Model::reserve_lists() {
-  reserve_with_slack(new_contacts_, contacts_.size());
-  reserve_with_slack(new_outputs_, contacts_.size());
-}
-
 void Model::merge_candidates() {
-  // Merge the candidates with the existing contacts (both sorted by key) into fresh arrays.
+  // Merge the candidates with the existing contacts (both sorted by key): decide which stay and
+  // make the new ones (events in key order), then rebuild the list in place (contact_list.cpp).
   assert(std::adjacent_find(candidate_keys_.begin(), candidate_keys_.end(),
                             std::greater_equal<>()) == candidate_keys_.end() &&
          "candidate keys sorted and unique");
@@ -198,37 +185,29 @@ void Model::merge_candidates() {
                             [](const Contact& x, const Contact& y) { return x.key >= y.key; }) ==
              contacts_.end() &&
          "contacts sorted by key");
-  new_contacts_.clear();
-  new_outputs_.clear();
-  new_batches_.clear();
-  new_batches_.reserve_like(batches_);
-  reserve_lists();
+  keep_.assign(contacts_.size(), 1);
+  order_.clear();
   std::size_t a = 0, b = 0;
-  auto keep = [&](std::size_t ci) {
-    Contact c = contacts_[ci];
-    c.slot = move_contact_data(new_batches_, batches_, c.model, c.slot);
-    new_contacts_.push_back(c);
-    new_outputs_.push_back(outputs_[ci]);
-  };
   while (a < contacts_.size() || b < candidate_keys_.size()) {
     if (b == candidate_keys_.size() ||
         (a < contacts_.size() && contacts_[a].key < candidate_keys_[b])) {
       const Contact& c = contacts_[a];
-      if (contact_keeps_alive(batches_, c.model, c.slot))
-        keep(a);
-      else
+      if (contact_keeps_alive(batches_, c.model, c.slot)) {
+        order_.push_back(0);
+      } else {
+        keep_[a] = 0;
         retire_contact(a);
+      }
       ++a;
     } else if (a == contacts_.size() || candidate_keys_[b] < contacts_[a].key) {
       create_contact(candidate_keys_[b++]);
     } else {
-      keep(a++);
+      order_.push_back(0);
+      ++a;
       ++b;
     }
   }
-  std::swap(contacts_, new_contacts_);
-  std::swap(outputs_, new_outputs_);
-  std::swap(batches_, new_batches_);
+  rebuild_contacts();
 }
 
 void Model::retire_contact(std::size_t ci) {
@@ -286,14 +265,15 @@ void Model::create_contact(std::uint64_t key) {
     };
     ModelProps props = rule->props;
     inherit_properties(props, surf(balls.group[end1]), surf(balls.group[end2]));
-    c.slot = create_contact_data(new_batches_, props, info);
+    c.slot = create_contact_data(added_batches_, props, info);
   } else {
-    c.slot = create_contact_data(new_batches_, rule->props, info);
+    c.slot = create_contact_data(added_batches_, rule->props, info);
   }
   ContactOutput o;
-  o.stiff = contact_stiffness(new_batches_, c.model, c.slot);
-  new_contacts_.push_back(c);
-  new_outputs_.push_back(o);
+  o.stiff = contact_stiffness(added_batches_, c.model, c.slot);
+  added_contacts_.push_back(c);
+  added_outputs_.push_back(o);
+  order_.push_back(1);
   Event ev;
   ev.type = EventType::ContactCreated;
   ev.step = step_;

@@ -143,33 +143,9 @@ void Model::remove_walls(const std::vector<bool>& remove) {
     detect();
 }
 
-void Model::compact_contacts(const std::function<bool(Contact&)>& keep) {
-  // Keep (and let `keep` renumber) some contacts in their order; the dropped ones retire their
-  // dissipation. Model data is compacted into fresh batches.
-  new_contacts_.clear();
-  new_outputs_.clear();
-  new_batches_.clear();
-  new_batches_.reserve_like(batches_);
-  reserve_lists();
-  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
-    Contact c = contacts_[ci];
-    if (!keep(c)) {
-      retire_dissipation(contacts_[ci]);
-      continue;
-    }
-    c.key = contact_key(c.kind, c.end1, c.end2);
-    c.slot = move_contact_data(new_batches_, batches_, c.model, c.slot);
-    new_contacts_.push_back(c);
-    new_outputs_.push_back(outputs_[ci]);
-  }
-  std::swap(contacts_, new_contacts_);
-  std::swap(outputs_, new_outputs_);
-  std::swap(batches_, new_batches_);
-}
-
 void Model::replace_contact_model(std::size_t ci, const ModelProps& props) {
   Contact& c = contacts_[ci];
-  retire_dissipation(c); // the old data is dropped at the next compaction
+  retire_dissipation(c); // the old data is dropped when the list is next rebuilt (packed)
   CreationInfo info;
   info.dim = settings.dim;
   info.R1 = balls.radius[static_cast<std::size_t>(c.end1)];

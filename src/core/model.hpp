@@ -157,9 +157,9 @@ public:
     return density_scaled() ? balls.inertia[i] * inertia_scale_[i] : balls.inertia[i];
   }
 
-  /// Free the scratch arrays a detection rebuilds the contact list into (about as large as the
-  /// list itself); the next detection allocates them again. For the end of a run, when outputs
-  /// are written: a 10k-grain flat-jointed UCS held 24 MB there.
+  /// Free the scratch arrays of contact detection (candidate keys, a byte per contact of the
+  /// rebuild plan, the contacts a detection adds); the next detection allocates them again. For
+  /// the end of a run, when outputs are written.
   void release_scratch();
 
   /// Read or write the whole state (archive = specimen/checkpoint reader or writer).
@@ -176,7 +176,11 @@ private:
   /// Add `share` of a contact's energies to the group ledgers (sharing rule).
   void share_contact_energy(const Contact& c, const ContactEnergy& e,
                             std::vector<EnergyLedger>& out) const;
+  // contact_list.cpp
   void compact_contacts(const std::function<bool(Contact&)>& keep);
+  void rebuild_contacts();
+  bool batches_packed() const;
+  void pack_batches();
   // detection.cpp
   void detect();
   detail::CellGrid bin_balls();
@@ -200,12 +204,12 @@ private:
   std::vector<Contact> contacts_;
   std::vector<ContactOutput> outputs_;
   ModelBatches batches_;
-  // Scratch storage reused between detections (no allocation in the steady cycle).
-  std::vector<Contact> new_contacts_;
-  std::vector<ContactOutput> new_outputs_;
-  /// Capacity of the rebuilt lists for today's contacts and 1/16 more (no growth by doubling).
-  void reserve_lists();
-  ModelBatches new_batches_;
+  // Scratch storage reused between detections (no allocation in the steady cycle): the contacts
+  // a detection adds and the plan of the rebuilt list (contact_list.cpp).
+  std::vector<Contact> added_contacts_;
+  std::vector<ContactOutput> added_outputs_;
+  ModelBatches added_batches_;
+  std::vector<std::uint8_t> keep_, order_;
   std::vector<std::uint64_t> candidate_keys_;
   std::vector<std::vector<std::uint64_t>> thread_keys_;
   std::vector<std::int32_t> cell_start_, cell_items_;
