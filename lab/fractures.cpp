@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <ostream>
 #include <unordered_map>
 
 namespace rocklab {
@@ -148,18 +149,19 @@ std::vector<ContactCrack> contact_cracks(const std::vector<Crack>& cracks,
   return out;
 }
 
-std::string events_csv(const std::vector<FractureEvent>& events) {
-  std::string s = "event,time_s,duration_s,x_m,y_m,z_m,cracks,contacts,tension,shear,energy_J,"
-                  "magnitude\n";
+void write_events_csv(std::ostream& out, const std::vector<FractureEvent>& events) {
+  out << "event,time_s,duration_s,x_m,y_m,z_m,cracks,contacts,tension,shear,energy_J,"
+         "magnitude\n";
+  std::string s; // one row at a time
   for (const FractureEvent& e : events) {
-    s += std::to_string(e.id) + ',' + format_double(e.time) + ',' + format_double(e.duration);
+    s = std::to_string(e.id) + ',' + format_double(e.time) + ',' + format_double(e.duration);
     for (int k = 0; k < 3; ++k)
       s += ',' + format_double(e.position[k]);
     s += ',' + std::to_string(e.cracks) + ',' + std::to_string(e.contacts) + ',' +
          std::to_string(e.tension) + ',' + std::to_string(e.shear) + ',' + format_double(e.energy) +
          ',' + (std::isfinite(e.magnitude) ? format_double(e.magnitude) : "") + '\n';
+    out << s;
   }
-  return s;
 }
 
 } // namespace rocklab

@@ -7,6 +7,7 @@
 
 #include "lab/crack_monitor.hpp"
 
+#include <iosfwd>
 #include <string>
 #include <utility>
 #include <vector>
@@ -71,6 +72,6 @@ std::vector<FractureEvent> events_until(const std::vector<Crack>& cracks, const 
                                         double until);
 
 /// events.csv: one row per event, SI units.
-std::string events_csv(const std::vector<FractureEvent>& events);
+void write_events_csv(std::ostream& out, const std::vector<FractureEvent>& events);
 
 } // namespace rocklab

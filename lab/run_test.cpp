@@ -332,9 +332,9 @@ void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::t
                      {"model_time_s", model->time()},
                      {"threads", omp_get_max_threads()},
                      {"wall_time_s", sum.wall_seconds}};
-  write_text_file(out.staged("history.csv"), f.history_csv());
+  write_file(out.staged("history.csv"), [&](std::ostream& o) { f.write_history_csv(o); });
   write_file(out.staged("cracks.csv"), [&](std::ostream& o) { f.cracks().write_csv(o); });
-  write_text_file(out.staged("events.csv"), events_csv(ev.events));
+  write_file(out.staged("events.csv"), [&](std::ostream& o) { write_events_csv(o, ev.events); });
   sum.files.insert(sum.files.end(), {"results.json", "history.csv", "cracks.csv", "events.csv"});
   if (p.plots)
     write_plots(test, f, meta, r, ev, out, sum.files);

@@ -4,6 +4,7 @@
 #include "lab/fractures.hpp"
 
 #include <cmath>
+#include <sstream>
 
 namespace rocklab {
 namespace {
@@ -84,7 +85,9 @@ TEST(Fractures, TheDefaultWindowIsAPWaveCrossingFiveGrains) {
   EXPECT_EQ(default_event_window(0, 2650, 1e-3), 0);
   // events.csv: a header and a row per event
   const std::vector<Crack> cs = {crack(0.0, 1, 2, 100), crack(1.0, 5, 6, 101)};
-  const std::string csv = events_csv(cluster_events(cs, {}, 0.1).events);
+  std::ostringstream written;
+  write_events_csv(written, cluster_events(cs, {}, 0.1).events);
+  const std::string csv = written.str();
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3);
   EXPECT_EQ(csv.rfind("event,time_s,", 0), 0u);
 }

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <ostream>
 #include <stdexcept>
 
 namespace rocklab {
@@ -132,20 +133,22 @@ void LoadingFrame::record_history() {
   history_.push_back(std::move(row));
 }
 
-std::string LoadingFrame::history_csv() const {
+void LoadingFrame::write_history_csv(std::ostream& out) const {
   // Energies count from the start of loading; rows before it (confining, seating) from the start
   // of the test.
-  std::string s = "time_s,step,phase,axial_strain,lateral_strain,volumetric_strain,axial_stress_Pa,"
-                  "lateral_stress_Pa,deviator_Pa,force_N,cracks_tension,cracks_shear,"
-                  "cracks_total,kinetic_J,strain_J,bond_strain_J,slip_J,local_damping_J,"
-                  "dashpot_J,plastic_J,bond_break_J,body_work_J,boundary_work_J,"
-                  "balance_error_J\n";
+  out << "time_s,step,phase,axial_strain,lateral_strain,volumetric_strain,axial_stress_Pa,"
+         "lateral_stress_Pa,deviator_Pa,force_N,cracks_tension,cracks_shear,"
+         "cracks_total,kinetic_J,strain_J,bond_strain_J,slip_J,local_damping_J,"
+         "dashpot_J,plastic_J,bond_break_J,body_work_J,boundary_work_J,"
+         "balance_error_J\n";
   const EnergyLedger start = energy_start_.size() == EnergyLedger::kTerms
                                  ? ledger_from(energy_start_.data())
                                  : EnergyLedger{};
   const EnergyLedger load =
       energy_load_.size() == EnergyLedger::kTerms ? ledger_from(energy_load_.data()) : start;
+  std::string s; // one row at a time
   for (const auto& row : history_) {
+    s.clear();
     for (std::size_t k = 0; k < kMeasured; ++k) {
       if (k)
         s += ',';
@@ -158,8 +161,8 @@ std::string LoadingFrame::history_csv() const {
                      e.plastic, e.bond_break, e.body_work, e.boundary_work, e.balance_error()})
       s += ',' + format_double(v);
     s += '\n';
+    out << s;
   }
-  return s;
 }
 
 void LoadingFrame::finish(const std::string& why) {

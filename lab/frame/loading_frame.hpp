@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -121,7 +122,7 @@ public:
   void restore(const nlohmann::json& state, const std::string& file);
   /// results.json: the frame's part and the protocol's.
   nlohmann::json results() const;
-  std::string history_csv() const;
+  void write_history_csv(std::ostream& out) const;
 
   // What protocols read.
   const Protocol& protocol() const { return p_; }
