@@ -133,12 +133,6 @@ struct FlatJointElements {
     c.elem = static_cast<std::uint32_t>(at);
     return at + c.n_elem;
   }
-  /// Grow or shrink to n elements (capacity for n and 1/16 more when it grows).
-  void resize(std::size_t n) {
-    if (all.capacity() < n)
-      all.reserve(n + n / 16 + 64);
-    all.resize(n);
-  }
   /// Move c's elements to end at `end` (their end <= `end`); returns where they now start.
   std::size_t place_before(FlatJointContact& c, std::size_t end) {
     const std::size_t at = end - c.n_elem;

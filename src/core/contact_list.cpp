@@ -74,7 +74,8 @@ void place_all(Batch<M>& b, const Batch<M>& from, std::size_t kept, std::vector<
   if constexpr (HasPool<M>) {
     pool_end = kept == 0 ? 0 : b.contacts[kept - 1].elem + b.contacts[kept - 1].n_elem;
     pool_end += from.pool.size();
-    b.pool.resize(pool_end);
+    reserve_with_slack(b.pool.all, pool_end);
+    b.pool.all.resize(pool_end);
   }
   for (std::size_t f = list.size(); f-- > 0;) {
     Contact& c = list[f];

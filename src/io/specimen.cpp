@@ -18,6 +18,9 @@ namespace rocklab {
 
 static_assert(std::endian::native == std::endian::little, "specimen files are little-endian");
 
+/// Bodies are written, hashed and read a chunk of this many bytes at a time.
+constexpr std::size_t kArchiveChunk = std::size_t{1} << 20;
+
 /// Writes fields a chunk of about 1 MiB at a time to `out`, or without `out` only counts and
 /// hashes them (the header line before the body gives its size and hash).
 struct ArchiveWriter {
@@ -29,7 +32,7 @@ struct ArchiveWriter {
   void put(const char* p, std::size_t n) {
     bytes.append(p, n);
     size += n;
-    if (bytes.size() >= (std::size_t{1} << 20))
+    if (bytes.size() >= kArchiveChunk)
       flush();
   }
   void flush() {
@@ -70,7 +73,6 @@ struct ArchiveReader {
   std::string chunk;
   std::size_t at = 0; ///< the next byte of `chunk`
   static constexpr bool reading = true;
-  static constexpr std::size_t kChunk = std::size_t{1} << 20;
 
   std::uint64_t remaining() const { return size - pos; }
   void need(std::uint64_t n) {
@@ -83,8 +85,8 @@ struct ArchiveReader {
     pos += n;
     while (n > 0) {
       if (at == chunk.size()) {
-        chunk.resize(kChunk);
-        in.read(chunk.data(), static_cast<std::streamsize>(kChunk));
+        chunk.resize(kArchiveChunk);
+        in.read(chunk.data(), static_cast<std::streamsize>(kArchiveChunk));
         chunk.resize(static_cast<std::size_t>(in.gcount()));
         at = 0;
         if (chunk.empty())
@@ -383,7 +385,7 @@ std::unique_ptr<Model> load_model(const std::string& path, nlohmann::json* meta)
   const std::streampos body_start = in.tellg();
   std::uint64_t body_size = 0, hash = fnv1a64("");
   {
-    std::string chunk(std::size_t{1} << 20, '\0');
+    std::string chunk(kArchiveChunk, '\0');
     while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
       const auto n = static_cast<std::size_t>(in.gcount());
       body_size += n;
