@@ -36,6 +36,9 @@ struct Protocol {
   double reverse_at_strain = 0; ///< > 0: unload from this axial strain back to zero (elastic test)
   /// Brazilian: 0 flat platens; > 0 curved jaws (ISRM 1978) of this times the disk's radius.
   double jaw_radius_ratio = 0;
+  /// >= 0: the platens' ball-facet friction coefficient (0 lubricated, steel on rock unlubricated
+  /// about 0.2-0.5); < 0: the test's own (UCS, triaxial: 0; Brazilian: the specimen's wall rule).
+  double platen_friction = -1;
   /// > 0: density scaling from the start of loading, the time step raised to this quantile of
   /// the grains' own stable steps (Model::scale_density); 0: off.
   double density_scaling = 0;

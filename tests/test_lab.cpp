@@ -405,6 +405,30 @@ TEST(Lab, TriaxialHoldsTheConfinementAndPeakRisesWithIt) {
   }
 }
 
+TEST(Lab, PlatenFrictionRestrainsTheEndsAndRaisesTheStrength) {
+  // loading.platen_friction: unlubricated platens hold the specimen's ends against the lateral
+  // expansion, so the same specimen is stiffer and stronger than between lubricated ones (the
+  // end effect that makes ISRM ask for slender cores), and the platens' slip dissipates energy.
+  const std::string spec = specimen("lab_2d_bonded");
+  nlohmann::json r[2];
+  for (int k = 0; k < 2; ++k) {
+    nlohmann::json j{{"test", "ucs"},
+                     {"specimen", {{"file", spec}}},
+                     {"output", {{"vtk", false}, {"plots", false}}}};
+    if (k == 1)
+      j["loading"] = {{"platen_friction", 0.5}};
+    r[k] = run("platen_friction", j, scratch("platen_friction")).results;
+  }
+  EXPECT_EQ(r[0]["platen_friction"], 0.0);
+  EXPECT_EQ(r[1]["platen_friction"], 0.5);
+  const double peak0 = r[0]["peak_stress_Pa"], peak1 = r[1]["peak_stress_Pa"];
+  const double e0 = r[0]["youngs_modulus_Pa"], e1 = r[1]["youngs_modulus_Pa"];
+  std::printf("lubricated: UCS %.4g Pa, E %.4g Pa; friction 0.5: UCS %.4g Pa, E %.4g Pa\n", peak0,
+              e0, peak1, e1);
+  EXPECT_GT(peak1, 1.02 * peak0);
+  EXPECT_GT(e1, e0);
+}
+
 TEST(Lab, BrazilianAndDirectTension) {
   const fs::path bz_out = scratch("bz");
   const LabSummary bz = run(
@@ -852,6 +876,12 @@ TEST(Lab, BadProtocolsFailClearlyAndWriteNothing) {
         {"specimen", {{"file", spec}}},
         {"loading", {{"jaw_radius_ratio", 2.0}}}},
        "applies to \"jaws\": \"curved\" only"},
+      {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"platen_friction", -0.1}}}},
+       "key 'loading.platen_friction'"},
+      {{{"test", "direct_tension"},
+        {"specimen", {{"file", spec}}},
+        {"loading", {{"platen_friction", 0.3}}}},
+       "a direct tension test has grips, not platens"},
       {{{"test", "ucs"}, {"specimen", {{"file", spec}}}, {"loading", {{"density_scaling", 1.0}}}},
        "key 'loading.density_scaling': value 1.0 is out of range [0, 1)"}};
   for (const Case& k : cases) {

@@ -434,6 +434,9 @@ nlohmann::json LoadingFrame::results() const {
   r["units"] = "SI (m, kg, s, N, Pa, J); stresses and strains compression positive";
   r["test"] = test_.name();
   r["stop_reason"] = stop_reason_;
+  for (const ModelRule& rule : m_.rules) // the platens' friction, as the model has it
+    if (top_ >= 0 && rule.wall == top_ && std::holds_alternative<LinearProps>(rule.props))
+      r["platen_friction"] = std::get<LinearProps>(rule.props).fric;
   const double crack_area = [&] {
     double a = 0;
     for (const Crack& c : monitor_.cracks())

@@ -177,6 +177,7 @@ private:
   LinearProps platen_contact(bool friction) const;
   std::int64_t add_wall(Wall w, const LinearProps& props);
   void add_platens(const LinearProps& props);
+  LinearProps platen_props(LinearProps props) const; ///< with loading.platen_friction
   Wall curved_jaw(const std::string& name, int side) const;
   void add_grips();
   void add_confinement(const LinearProps& props);

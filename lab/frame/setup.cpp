@@ -48,7 +48,7 @@ void LoadingFrame::setup() {
   if (setup.actuator == Actuator::Grips)
     add_grips();
   else
-    add_platens(props);
+    add_platens(platen_props(props));
   if (setup.confined)
     add_confinement(props);
   find_shell();
@@ -139,6 +139,14 @@ LinearProps LoadingFrame::platen_contact(bool friction) const {
     }
   throw InputError(p_.file + ": the specimen has no linear ball-facet contact rule for the "
                              "platens (specimens made by rocklab genesis have one)");
+}
+
+LinearProps LoadingFrame::platen_props(LinearProps props) const {
+  // loading.platen_friction: end friction of unlubricated platens (the confining walls, a
+  // membrane, stay as the test has them).
+  if (p_.platen_friction >= 0)
+    props.fric = p_.platen_friction;
+  return props;
 }
 
 std::int64_t LoadingFrame::add_wall(Wall w, const LinearProps& props) {

@@ -12,6 +12,8 @@ void FrameTest::check_loading(JsonObject& loading, const Protocol& p) const {
     loading.fail("confinement", "only a triaxial test is confined (use \"test\": \"triaxial\")");
   if (p.jaw_radius_ratio > 0 && !setup().diametral)
     loading.fail("jaws", "curved jaws load Brazilian disks only");
+  if (p.platen_friction >= 0 && setup().actuator == Actuator::Grips)
+    loading.fail("platen_friction", "a direct tension test has grips, not platens");
 }
 
 void FrameTest::check_stop(JsonObject& stop) const {
