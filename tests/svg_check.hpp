@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -73,18 +74,22 @@ inline double svg_axis_value(const std::vector<SvgTick>& t, double pos) {
                                (t.back().value - t.front().value);
 }
 
-/// The points of each polyline, in SVG pixels.
+/// The points of each polyline, in SVG pixels. (Read without std::regex: libstdc++'s recursive
+/// matcher overflows the stack on a polyline of thousands of points.)
 inline std::vector<std::vector<std::pair<double, double>>> svg_polylines(const std::string& svg) {
   std::vector<std::vector<std::pair<double, double>>> out;
-  const std::regex re("<polyline[^>]* points=\"([^\"]*)\"");
-  const std::regex pt("([-0-9.]+),([-0-9.]+)");
-  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), re); it != std::sregex_iterator();
-       ++it) {
-    const std::string pts = (*it)[1];
+  for (std::size_t at = svg.find("<polyline"); at != std::string::npos;
+       at = svg.find("<polyline", at + 1)) {
+    const std::size_t end = svg.find('>', at);
+    const std::size_t pts = svg.find(" points=\"", at);
+    if (pts == std::string::npos || pts > end)
+      continue;
+    std::istringstream in(svg.substr(pts + 9, svg.find('"', pts + 9) - pts - 9));
     out.emplace_back();
-    for (auto p = std::sregex_iterator(pts.begin(), pts.end(), pt); p != std::sregex_iterator();
-         ++p)
-      out.back().emplace_back(std::stod((*p)[1]), std::stod((*p)[2]));
+    double x = 0, y = 0;
+    char comma = 0;
+    while (in >> x >> comma >> y && comma == ',')
+      out.back().emplace_back(x, y);
   }
   return out;
 }

@@ -2,9 +2,13 @@
 // legend off the data, a PNG beside each SVG (viz/svg_plots, viz/svg_png).
 #include "helpers.hpp"
 #include "svg_check.hpp"
+#include "viz/polyline_thin.hpp"
 #include "viz/svg_plots.hpp"
 #include "viz/svg_png.hpp"
 
+#include <algorithm>
+#include <array>
+#include <cstdint>
 #include <regex>
 
 namespace rocklab {
@@ -53,6 +57,66 @@ TEST(Plots, TickLabelsAreTheValuesAtTheirPositions) {
   for (const auto& t : test::svg_ticks(svg, "xtick"))
     zero = zero || t.text == "0" || t.text == "0.0" || t.text == "0.00";
   EXPECT_TRUE(zero);
+}
+
+// Distance of (x, y) from the polyline.
+double distance_to(const std::vector<std::pair<double, double>>& line, double x, double y) {
+  double best = INFINITY;
+  for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+    const auto [ax, ay] = line[i];
+    const auto [bx, by] = line[i + 1];
+    const double dx = bx - ax, dy = by - ay, l2 = dx * dx + dy * dy;
+    const double t = l2 > 0 ? std::clamp(((x - ax) * dx + (y - ay) * dy) / l2, 0.0, 1.0) : 0.0;
+    best = std::min(best, std::hypot(x - ax - t * dx, y - ay - t * dy));
+  }
+  return best;
+}
+
+TEST(Plots, ADenseCurveIsDrawnThroughFewerPointsWithinATwentiethOfAPixel) {
+  // thin_polyline: the ends kept, a straight run reduced to its ends, a zigzag above the
+  // tolerance kept whole, and every dropped point within the tolerance of the kept line.
+  std::vector<std::array<double, 2>> straight, zigzag;
+  for (int i = 0; i <= 100; ++i) {
+    straight.push_back({i * 1.0, 2.0 * i});
+    zigzag.push_back({i * 1.0, i % 2 ? 0.2 : 0.0});
+  }
+  EXPECT_EQ(thin_polyline(straight, 0.05), (std::vector<std::size_t>{0, 100}));
+  EXPECT_EQ(thin_polyline(zigzag, 0.05).size(), zigzag.size());
+  EXPECT_EQ(thin_polyline(zigzag, 0.3), (std::vector<std::size_t>{0, 100}));
+  // A stress-strain curve of 40,000 samples with a jittery post-peak branch (0.1 MPa) and a lateral
+  // strain that turns back (a volumetric reversal): far fewer points, each sample within 0.05 px of
+  // the drawn line (+ the rounding of the two-decimal coordinates and tick positions).
+  PlotSeries axial{"axial", {}, {}, "#000000"}, vol{"volumetric", {}, {}, "#2ca02c", true};
+  std::uint64_t state = 12345;
+  auto noise = [&] {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(state >> 11) / 9007199254740992.0 - 0.5;
+  };
+  for (int i = 0; i < 40000; ++i) {
+    const double e = 0.4 * i / 40000.0; // axial strain [%]
+    const double s = e < 0.29 ? 160 * std::sin(e / 0.29 * 1.5707963) : 160 - 600 * (e - 0.29);
+    axial.x.push_back(e), axial.y.push_back(s + (e > 0.29 ? 0.1 * noise() : 0));
+    vol.x.push_back(e - 0.5 * e * e / 0.29), vol.y.push_back(s);
+  }
+  const std::string svg = line_plot_svg("t", "strain [%]", "stress [MPa]", "", {axial, vol});
+  const auto lines = test::svg_polylines(svg);
+  ASSERT_EQ(lines.size(), 2u);
+  const auto xt = test::svg_ticks(svg, "xtick"), yt = test::svg_ticks(svg, "ytick");
+  for (std::size_t k = 0; k < 2; ++k) {
+    const PlotSeries& p = k == 0 ? axial : vol;
+    EXPECT_LT(lines[k].size(), p.x.size() / 10) << p.label;
+    EXPECT_GT(lines[k].size(), 20u) << p.label;
+    // pixel positions of the samples from the axes' own ticks
+    auto px = [&](const std::vector<test::SvgTick>& t, double v) {
+      return t.front().pos + (v - t.front().value) * (t.back().pos - t.front().pos) /
+                                 (t.back().value - t.front().value);
+    };
+    double worst = 0;
+    for (std::size_t i = 0; i < p.x.size(); i += 7)
+      worst = std::max(worst, distance_to(lines[k], px(xt, p.x[i]), px(yt, p.y[i])));
+    EXPECT_LT(worst, 0.065) << p.label;
+  }
+  EXPECT_LT(svg.size(), 200000u);
 }
 
 TEST(Plots, TheLegendIsDrawnOffTheData) {
@@ -110,6 +174,32 @@ TEST(Plots, MarkerLabelsThatWouldOverlapAreStacked) {
   };
   EXPECT_LE(y_of("ratios"), y_of("strength") - 13); // a line higher: they would overlap
   EXPECT_EQ(y_of("elastic"), y_of("strength"));     // far enough apart: same line
+}
+
+TEST(Plots, AMarkerLabelStaysInsideThePlotArea) {
+  // The 10k-grain UCS plot: "CI (crack volumetric strain)" at 70 % of the width ran over the
+  // right axis' tick labels. A label that would cross the frame's right edge is set to the left.
+  PlotSeries s{"axial", {0, 0.3, 0.4}, {0, 160, 80}, "#000000"};
+  PlotSeries c{"cracks", {0, 0.4}, {0, 24000}, "#d62728", false, true};
+  const std::vector<PlotMarker> marks{{0.28, 75, "CI (crack volumetric strain)"},
+                                      {0.05, 30, "CI (crack count)"}};
+  const std::string svg = line_plot_svg("t", "strain [%]", "stress [MPa]", "cracks", {s, c}, marks);
+  std::smatch frame;
+  ASSERT_TRUE(std::regex_search(
+      svg, frame,
+      std::regex("<rect x=\"([-0-9.]+)\" y=\"[-0-9.]+\" width=\"([-0-9.]+)\"[^>]*fill=\"none\"")));
+  const double left = std::stod(frame[1]), right = left + std::stod(frame[2]);
+  for (const PlotMarker& m : marks) {
+    const std::size_t at = svg.find(">" + m.label + "</text>");
+    ASSERT_NE(at, std::string::npos) << m.label;
+    const std::size_t open = svg.rfind("<text", at);
+    const std::string tag = svg.substr(open, at - open);
+    const double x = std::stod(tag.substr(tag.find(" x=\"") + 4));
+    const double width = 7.0 * static_cast<double>(m.label.size()); // about 7 px a character
+    const bool to_left = tag.find("text-anchor=\"end\"") != std::string::npos;
+    EXPECT_LE(to_left ? x : x + width, right) << m.label;
+    EXPECT_GE(to_left ? x - width : x, left) << m.label;
+  }
 }
 
 TEST(Plots, ASeriesWithOnePointIsDrawnAsADot) {
