@@ -253,6 +253,37 @@ std::vector<PlotSeries> to_log_axis(const std::vector<PlotSeries>& series,
   return logged;
 }
 
+// One series as a polyline (SVG pixels), or as a dot when it has a single finite point.
+std::string series_svg(const PlotFrame& f, const PlotSeries& p) {
+  std::vector<std::array<double, 2>> xy;
+  std::size_t last = 0;
+  for (std::size_t i = 0; i < p.x.size() && i < p.y.size(); ++i)
+    if (std::isfinite(p.x[i]) && std::isfinite(p.y[i])) {
+      xy.push_back({f.X(p.x[i]), f.Y(p.y[i], p.right_axis)});
+      last = i;
+    }
+  const std::size_t drawn = xy.size();
+  // A dense series (a 10k-grain test's curve: ~40k samples, hundreds per pixel column) drawn
+  // through the points that keep it within 0.05 px of every sample: a 2.7 MB SVG became 33 kB
+  // (its rendering had been the largest allocation at the test's end).
+  std::string pts;
+  auto add = [&](const std::array<double, 2>& q) { pts += num(q[0]) + "," + num(q[1]) + " "; };
+  if (drawn > kThinAbove)
+    for (std::size_t i : thin_polyline(xy, 0.05))
+      add(xy[i]);
+  else
+    for (const auto& q : xy)
+      add(q);
+  std::string s = "<polyline fill=\"none\" stroke=\"" + p.color + "\" stroke-width=\"1.6\"" +
+                  dash(p) + " points=\"" + pts + "\"/>\n";
+  // A series with one point draws no line: a dot shows it (a calibration target measured only by
+  // the final evaluation was invisible on the convergence plot).
+  if (drawn == 1)
+    s += "<circle class=\"point\" cx=\"" + num(f.X(p.x[last])) + "\" cy=\"" +
+         num(f.Y(p.y[last], p.right_axis)) + "\" r=\"4\" fill=\"" + p.color + "\"/>\n";
+  return s;
+}
+
 } // namespace
 
 std::string line_plot_svg(const std::string& title, const std::string& xlabel,
@@ -296,32 +327,7 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
          ") rotate(90)\" text-anchor=\"middle\">" + escape(y2label) + "</text>\n";
   double ly = lg.y + 8;
   for (const PlotSeries& p : series) {
-    std::vector<std::array<double, 2>> xy;
-    std::size_t last = 0;
-    for (std::size_t i = 0; i < p.x.size() && i < p.y.size(); ++i)
-      if (std::isfinite(p.x[i]) && std::isfinite(p.y[i])) {
-        xy.push_back({f.X(p.x[i]), f.Y(p.y[i], p.right_axis)});
-        last = i;
-      }
-    const std::size_t drawn = xy.size();
-    // A dense series (a 10k-grain test's curve: ~40k samples, hundreds per pixel column) drawn
-    // through the points that keep it within 0.05 px of every sample: a 2.7 MB SVG became
-    // ~0.1 MB and its rendering the largest allocation of a test's end.
-    std::string pts;
-    auto add = [&](const std::array<double, 2>& q) { pts += num(q[0]) + "," + num(q[1]) + " "; };
-    if (drawn > kThinAbove)
-      for (std::size_t i : thin_polyline(xy, 0.05))
-        add(xy[i]);
-    else
-      for (const auto& q : xy)
-        add(q);
-    s += "<polyline fill=\"none\" stroke=\"" + p.color + "\" stroke-width=\"1.6\"" + dash(p) +
-         " points=\"" + pts + "\"/>\n";
-    // A series with one point draws no line: a dot shows it (a calibration target measured only by
-    // the final evaluation was invisible on the convergence plot).
-    if (drawn == 1)
-      s += "<circle class=\"point\" cx=\"" + num(f.X(p.x[last])) + "\" cy=\"" +
-           num(f.Y(p.y[last], p.right_axis)) + "\" r=\"4\" fill=\"" + p.color + "\"/>\n";
+    s += series_svg(f, p);
     s += "<line class=\"legend\" x1=\"" + num(lg.x + 2) + "\" y1=\"" + num(ly) + "\" x2=\"" +
          num(lg.x + 26) + "\" y2=\"" + num(ly) + "\" stroke=\"" + p.color +
          "\" stroke-width=\"2\"" + dash(p) + "/>\n";
