@@ -408,7 +408,7 @@ TEST(Lab, TriaxialHoldsTheConfinementAndPeakRisesWithIt) {
 TEST(Lab, PlatenFrictionRestrainsTheEndsAndRaisesTheStrength) {
   // loading.platen_friction: unlubricated platens hold the specimen's ends against the lateral
   // expansion, so the same specimen is stiffer and stronger than between lubricated ones (the
-  // end effect that makes ISRM ask for slender cores), and the platens' slip dissipates energy.
+  // end effect that makes ISRM ask for slender cores); results.json reports the coefficient.
   const std::string spec = specimen("lab_2d_bonded");
   nlohmann::json r[2];
   for (int k = 0; k < 2; ++k) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <utility>
 
 namespace rocklab {
@@ -25,8 +26,7 @@ std::vector<std::size_t> thin_polyline(const std::vector<std::array<double, 2>>&
   const std::size_t n = points.size();
   if (n <= 2) {
     std::vector<std::size_t> all(n);
-    for (std::size_t i = 0; i < n; ++i)
-      all[i] = i;
+    std::iota(all.begin(), all.end(), std::size_t{0});
     return all;
   }
   std::vector<char> keep(n, 0);

@@ -256,12 +256,9 @@ std::vector<PlotSeries> to_log_axis(const std::vector<PlotSeries>& series,
 // One series as a polyline (SVG pixels), or as a dot when it has a single finite point.
 std::string series_svg(const PlotFrame& f, const PlotSeries& p) {
   std::vector<std::array<double, 2>> xy;
-  std::size_t last = 0;
   for (std::size_t i = 0; i < p.x.size() && i < p.y.size(); ++i)
-    if (std::isfinite(p.x[i]) && std::isfinite(p.y[i])) {
+    if (std::isfinite(p.x[i]) && std::isfinite(p.y[i]))
       xy.push_back({f.X(p.x[i]), f.Y(p.y[i], p.right_axis)});
-      last = i;
-    }
   const std::size_t drawn = xy.size();
   // A dense series (a 10k-grain test's curve: ~40k samples, hundreds per pixel column) drawn
   // through the points that keep it within 0.05 px of every sample: a 2.7 MB SVG became 33 kB
@@ -279,8 +276,8 @@ std::string series_svg(const PlotFrame& f, const PlotSeries& p) {
   // A series with one point draws no line: a dot shows it (a calibration target measured only by
   // the final evaluation was invisible on the convergence plot).
   if (drawn == 1)
-    s += "<circle class=\"point\" cx=\"" + num(f.X(p.x[last])) + "\" cy=\"" +
-         num(f.Y(p.y[last], p.right_axis)) + "\" r=\"4\" fill=\"" + p.color + "\"/>\n";
+    s += "<circle class=\"point\" cx=\"" + num(xy[0][0]) + "\" cy=\"" + num(xy[0][1]) +
+         "\" r=\"4\" fill=\"" + p.color + "\"/>\n";
   return s;
 }
 
