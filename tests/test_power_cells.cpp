@@ -2,7 +2,10 @@
 // packing's clipped cells fill the specimen's shape (volumes sum to its volume), and every face
 // between two grains is the same polygon seen from both, lying on their radical plane.
 #include "helpers.hpp"
+#include "viz/nonaffine.hpp"
 #include "viz/power_cells.hpp"
+
+#include <Eigen/Geometry>
 
 #include <numbers>
 #include <random>
@@ -96,6 +99,60 @@ TEST(PowerCells, ClippedCellsFillTheSpecimenAndShareTheirFaces) {
         }
       }
     EXPECT_GT(faces, cells.size());
+  }
+}
+
+// The non-affine strain (viz/nonaffine) over the power diagram's neighbours: zero for any affine
+// motion (a finite rotation, stretch and shear plus a translation), and a slip across a plane is
+// seen exactly by the grains with a neighbour across it and by no other.
+TEST(NonaffineStrain, ZeroForAffineMotionAndOnlyBesideASlipPlane) {
+  for (int dim : {3, 2}) {
+    std::vector<Vec3> ref;
+    std::vector<double> r;
+    random_packing(dim, ref, r);
+    const ClipShape shape = ClipShape::around(ref, r, dim, true);
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+    F(0, 0) = 1.004, F(1, 1) = 0.997, F(0, 1) = 0.002, F(2, 2) = dim == 3 ? 1.003 : 1.0;
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(0.5, Vec3::UnitZ()).toRotationMatrix();
+    std::vector<Vec3> pos, disp;
+    for (const Vec3& X : ref) {
+      pos.push_back(R * F * X + Vec3(1e-3, -2e-3, 0));
+      disp.push_back(pos.back() - X);
+    }
+    const PowerDiagram moved(pos, r, ClipShape::around(pos, r, dim, true));
+    const auto affine = nonaffine_strain(pos, disp, moved.neighbours(), dim);
+    for (const double e : affine)
+      EXPECT_LT(e, 1e-12) << dim;
+
+    // grains above y = 0 slide 40 um along x; the diagram of the reference packing
+    const double slip = 40e-6;
+    pos = ref;
+    for (Vec3& x : pos)
+      x.x() += x.y() > 0 ? slip : 0.0;
+    for (std::size_t i = 0; i < pos.size(); ++i)
+      disp[i] = pos[i] - ref[i];
+    const PowerDiagram still(ref, r, shape);
+    const auto strain = nonaffine_strain(pos, disp, still.neighbours(), dim);
+    std::size_t beside = 0;
+    double largest = 0;
+    for (std::size_t i = 0; i < ref.size(); ++i) {
+      bool across = false;
+      for (const std::size_t j : still.neighbours()[i])
+        across = across || (ref[j].y() > 0) != (ref[i].y() > 0);
+      if (across) {
+        ++beside;
+        EXPECT_GT(strain[i], 1e-4) << dim << " grain " << i;
+      } else {
+        EXPECT_LT(strain[i], 1e-12) << dim << " grain " << i;
+      }
+      largest = std::max(largest, strain[i]);
+    }
+    // about one grain layer each side of the plane; the misfit is bounded by slip / branch length
+    EXPECT_GT(beside, ref.size() / 20) << dim;
+    EXPECT_LT(beside, ref.size() / 2) << dim;
+    EXPECT_LT(largest, slip / 0.6e-3) << dim;
+    std::printf("%dD: %zu of %zu grains beside the slip plane, largest non-affine strain %.4f\n",
+                dim, beside, ref.size(), largest);
   }
 }
 

@@ -49,6 +49,9 @@ public:
   PowerDiagram(const std::vector<Vec3>& pos, const std::vector<double>& radius,
                const ClipShape& clip);
   std::size_t size() const { return pos_.size(); }
+  /// Every grain's neighbours: the grains whose power cells share a face with its cell (before
+  /// clipping), in ascending order.
+  const std::vector<std::vector<std::size_t>>& neighbours() const { return neighbours_; }
   /// The clipped cells of grains [first, last), in grain order. A grain whose power cell is
   /// empty (hidden by larger neighbours) gets an empty cell.
   std::vector<PowerCell> cells(std::size_t first, std::size_t last) const;

@@ -7,7 +7,9 @@
 
 Options: --at end|peak|N (the snapshot shown; default end), --color time|mode|event|damage
 (what colours the cracks; default time of formation), --grains (draw the grains as spheres or
-disks instead of their faced cells), --walls (show the platens), --size WxH (pixels).
+disks instead of their faced cells), --section (the faced grains behind a vertical plane through
+the specimen's axis, seen straight on and coloured by their non-affine strain: where the rock has
+come apart), --walls (show the platens), --size WxH (pixels).
 
 What it draws (rocklab test writes the series, viz/README.md):
 - the grains' power cells (cells.pvd): 3D the specimen's skin, faded, so the fracture inside
@@ -17,6 +19,10 @@ What it draws (rocklab test writes the series, viz/README.md):
   so broken contacts join into fracture surfaces, coloured by the time they formed [s] (or mode:
   tension orange, shear blue; event; damage) in a palette distinct from the grains';
 - legends with units and a caption with the test, material, axial strain and stress of the frame.
+With --section, instead: the cells of the grains whose centres lie behind the plane through the
+axis facing the camera (whole grains, so the cut shows their faces), coloured by the non-affine
+strain since loading began [-] (viz/nonaffine.hpp): intact rock dark, however strained, and the
+fracture zone bright where grains moved apart or slid past their neighbours.
 The camera frames the specimen (not the platens, which are metres wide).
 """
 import json
@@ -31,7 +37,8 @@ from paraview.simple import (
 
 def parse(argv):
     opts = {"out": os.environ.get("ROCKLAB_OUT", "."), "png": None, "frames": None, "at": "end",
-            "color": "time", "grains": False, "walls": False, "size": (1600, 1200)}
+            "color": "time", "grains": False, "walls": False, "section": False,
+            "size": (1600, 1200)}
     args = list(argv)
     positional = []
     while args:
@@ -45,7 +52,7 @@ def parse(argv):
                 opts["size"] = (int(w), int(h))
             else:
                 opts[a[2:]] = v
-        elif a in ("--grains", "--walls"):
+        elif a in ("--grains", "--walls", "--section"):
             opts[a[2:]] = True
         elif a.startswith("--"):
             raise SystemExit("unknown option %s (see the top of %s)" % (a, __file__))
@@ -162,6 +169,50 @@ def show_cracks(view, cracks, field, results, times, dim):
         pass
 
 
+# The section's colour scale ends at this percentile of the grains' faces: the few grains spalled
+# off the surface (non-affine strain 5-10 times the fracture zone's) would otherwise leave the
+# rest of the picture dark.
+SECTION_CAP = 95
+
+
+def upper_percentile(source, array, t, q):
+    """The q-th percentile of a cell array at time t (a colour scale that a few outlying grains
+    do not wash out)."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    source.UpdatePipeline(t)
+    data = servermanager.Fetch(source)
+    a = data.GetCellData().GetArray(array) if data is not None else None
+    if a is None or a.GetNumberOfTuples() == 0:
+        return 1.0
+    v = float(np.percentile(vtk_to_numpy(a), q))
+    return v if v > 0 else 1.0
+
+
+def show_section(view, cells, times, dim):
+    """3D: the faced grains behind the vertical plane through the axis that faces the camera
+    (the camera looks along +y); 2D: every cell. Coloured by their non-affine strain since
+    loading began."""
+    half = cells
+    if dim == 3:
+        b = cells.GetDataInformation().GetBounds()
+        side = Calculator(Input=cells)
+        side.AttributeType = "Cell Data"
+        side.ResultArrayName = "behind_axis_m"
+        side.Function = "grain_center_Y - %.17g" % (0.5 * (b[2] + b[3]))
+        half = threshold(side, "behind_axis_m", 0.0, 1e30)
+    sd = Show(half, view)
+    ColorBy(sd, ("CELLS", "nonaffine_strain"))
+    lut = GetColorTransferFunction("nonaffine_strain")
+    lut.ApplyPreset("Inferno (matplotlib)", True)
+    top = upper_percentile(cells, "nonaffine_strain", times[-1] if times else None, SECTION_CAP)
+    lut.RescaleTransferFunction(0.0, top)
+    sd.SetRepresentationType("Surface With Edges")
+    sd.EdgeColor = [0.35, 0.35, 0.35]
+    legend(view, lut, "non-affine strain since loading [-]\n(scale ends at the %dth percentile)"
+           % SECTION_CAP, [0.03, 0.08])
+
+
 def main(argv):
     o = parse(argv)
     vtk_dir = os.path.join(o["out"], "vtk")
@@ -193,8 +244,17 @@ def main(argv):
     scene = GetAnimationScene()
     scene.UpdateAnimationUsingDataTimeSteps()
 
+    section = o["section"] and cells is not None
+    if o["section"] and not section:
+        raise SystemExit("--section needs the faced cells (%s/cells.pvd)" % vtk_dir)
+    if section:
+        cells.UpdatePipeline(times[-1] if times else None)
+        if cells.GetCellDataInformation().GetArray("nonaffine_strain") is None:
+            raise SystemExit("--section: %s/cells.pvd has no nonaffine_strain (written by rocklab"
+                             " from version 0.1.0 of 2026-12-04 on)" % vtk_dir)
+        show_section(view, cells, times, dim)
     # Grains: faced cells (3D: the skin, faded) or spheres/disks.
-    if cells is not None and not o["grains"]:
+    elif cells is not None and not o["grains"]:
         if dim == 3:
             skin = threshold(cells, "boundary", 0.5, 1.5)
             gd = Show(skin, view)
@@ -225,7 +285,7 @@ def main(argv):
         gd.Opacity = 0.25 if dim == 3 else 1.0
     Hide(grains, view)
 
-    if cracks is not None:
+    if cracks is not None and not section:
         show_cracks(view, cracks, o["color"], results, times, dim)
 
     if o["walls"]:
@@ -245,10 +305,12 @@ def main(argv):
         name = results.get("test", "test")
         material = results.get("provenance", {}).get("material", "")
         caption.Text = ("%s test  %s  (loading axis vertical)\n"
-                        "axial strain %.3f %%   axial stress %.1f MPa   step %d") % (
+                        "axial strain %.3f %%   axial stress %.1f MPa   step %d%s") % (
             name.upper(), material, 100 * f.get("axial_strain", 0.0),
-            1e-6 * f.get("axial_stress", 0.0), int(f.get("step", 0)))
-        frame_specimen(view, cells or grains, t, dim)
+            1e-6 * f.get("axial_stress", 0.0), int(f.get("step", 0)),
+            "\nsection through the axis: the grains behind it" if section and dim == 3 else "")
+        frame_specimen(view, cells or grains, t, 2 if section else dim,
+                       facing=(0, -1, 0) if section and dim == 3 else (0, 0, 1))
         Render(view)
 
     if o["frames"]:
@@ -269,8 +331,9 @@ def main(argv):
         print("wrote %s" % o["png"])
 
 
-def frame_specimen(view, source, t, dim):
-    """Point the camera at the specimen's bounds (2D: straight down z, parallel projection)."""
+def frame_specimen(view, source, t, dim, facing=(0, 0, 1)):
+    """Point the camera at the specimen's bounds. dim 2: a flat view from the `facing` side
+    (+z: the 2D plane; -y: a 3D section, z up), parallel projection."""
     source.UpdatePipeline(t)
     b = source.GetDataInformation().GetBounds()
     cx, cy, cz = 0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])
@@ -278,13 +341,19 @@ def frame_specimen(view, source, t, dim):
     cam = view.GetActiveCamera()
     view.CameraFocalPoint = [cx, cy, cz]
     if dim == 2:
-        view.CameraPosition = [cx, cy, cz + 4 * span]
-        view.CameraViewUp = [0, 1, 0]
+        up = 1 if facing[2] else 2  # the picture's vertical axis: y (2D) or z (a section)
+        across = b[1] - b[0]
+        h = max(b[2 * up + 1] - b[2 * up], 0.8 * across)
+        shift = [0.0, 0.0, 0.0]
+        shift[up] = 0.05 * h  # the specimen a little low: the caption above
+        focal = [cx + shift[0], cy + shift[1], cz + shift[2]]
+        eye = [focal[k] + 4 * span * facing[k] for k in range(3)]
+        view.CameraPosition = eye
+        view.CameraViewUp = [0, 1, 0] if up == 1 else [0, 0, 1]
         view.CameraParallelProjection = 1
         Render(view)  # the first render resets the camera; set the scale after it
-        h = max(b[3] - b[2], 0.8 * (b[1] - b[0]))
-        cam.SetFocalPoint(cx, cy + 0.05 * h, cz)  # the specimen a little low: the caption above
-        cam.SetPosition(cx, cy + 0.05 * h, cz + 4 * span)
+        cam.SetFocalPoint(*focal)
+        cam.SetPosition(*eye)
         cam.SetParallelScale(0.6 * h)
     else:  # an oblique view from the side, z (the loading axis) up
         view.CameraPosition = [cx + 2.2 * span, cy - 1.6 * span, cz + 0.5 * span]

@@ -1,8 +1,10 @@
 #include "io/output_dir.hpp"
+#include "viz/nonaffine.hpp"
 #include "viz/power_cells.hpp"
 #include "viz/vtk_output.hpp"
 #include "viz/vtk_write.hpp"
 
+#include <vtkFloatArray.h>
 #include <vtkInformation.h>
 #include <vtkInformationVector.h>
 #include <vtkObjectFactory.h>
@@ -183,6 +185,21 @@ FrameGrains read_grains(const std::filesystem::path& file) {
   return g;
 }
 
+// Each grain's non-affine strain since the test began (viz/nonaffine.hpp), its neighbours those of
+// the power diagram (grains either side of an opened crack stay neighbours), as a grain field the
+// cells carry.
+void add_nonaffine_strain(FrameGrains& g, const PowerDiagram& diagram, int dim) {
+  const auto d = g.info.point_tuples.find("displacement");
+  const std::size_t n = g.info.positions.size();
+  if (d == g.info.point_tuples.end() || d->second.size() != 3 * n)
+    return;
+  std::vector<Vec3> disp(n);
+  for (std::size_t i = 0; i < n; ++i)
+    disp[i] = Vec3(d->second[3 * i], d->second[3 * i + 1], d->second[3 * i + 2]);
+  g.info.point_values["nonaffine_strain"] =
+      nonaffine_strain(g.info.positions, disp, diagram.neighbours(), dim);
+}
+
 // The cells of grains [first, first + cells.size()): 3D every face of every cell (so each grain
 // is a closed polyhedron), 2D one polygon per cell; each carries its grain's index, id, cell
 // volume, whether it lies on the specimen's boundary, and the grain's scalar fields (stresses,
@@ -217,6 +234,14 @@ void add_cells(PolyBuilder& b, const std::vector<PowerCell>& cells, std::size_t 
   b.cell_array<std::int32_t, vtkIntArray>("grain", grain);
   b.cell_array<std::int32_t, vtkIntArray>("boundary", boundary);
   b.cell_array<double, vtkDoubleArray>("cell_volume", volume);
+  vtkNew<vtkFloatArray> centre; // to cut the specimen along whole grains (a section view)
+  centre->SetName("grain_center");
+  centre->SetNumberOfComponents(3);
+  for (const std::int32_t i : grain) {
+    const Vec3& x = g.info.positions[static_cast<std::size_t>(i)];
+    centre->InsertNextTuple3(x.x(), x.y(), x.z());
+  }
+  b.pd->GetCellData()->AddArray(centre);
   for (const auto& [name, values] : g.info.point_values) {
     std::vector<double> v;
     for (const std::int32_t i : grain)
@@ -270,7 +295,7 @@ CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at
   CellSummary sum;
   for (const auto& [index, t] : snapshot_files()) {
     Snapshot s = at(t);
-    const FrameGrains g = read_grains(dir_ / ("grains_" + index + ".vtu"));
+    FrameGrains g = read_grains(dir_ / ("grains_" + index + ".vtu"));
     s.step = static_cast<std::int64_t>(
         g.info.field_values.count("step") ? g.info.field_values.at("step") : 0);
     s.time = t;
@@ -290,9 +315,12 @@ CellSummary VtkSeries::write_fractures(const std::function<Snapshot(double)>& at
     // each contact crack as its grains' shared face, where their cells touch
     std::vector<std::vector<Vec3>> faces(s.contact_cracks.size());
     CellSummary cell_sum;
-    if (with_cells)
-      write_cells(PowerDiagram(g.info.positions, radius, shape), g, s, cell_piece_grains_, faces,
-                  cell_sum, dir_ / ("cells_" + index + ".vtp"));
+    if (with_cells) {
+      const PowerDiagram diagram(g.info.positions, radius, shape);
+      add_nonaffine_strain(g, diagram, s.dim);
+      write_cells(diagram, g, s, cell_piece_grains_, faces, cell_sum,
+                  dir_ / ("cells_" + index + ".vtp"));
+    }
     write_cracks(s.contact_cracks, s, true, dir_ / ("contact_cracks_" + index + ".vtp"), &faces);
     write_events(s.events, s, dir_ / ("events_" + index + ".vtp"));
     if (tagged_.contains(index))

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The ParaView set-up under test (issue 14): a small 3D flat-jointed UCS is run with the built
 # rocklab, viz/rocklab_paraview.py renders its end headless with ParaView's own pvbatch, and
-# check_png.py checks the picture (drawn, specimen filling the frame, cracks, legends). Run by
-# .ci/run after the README's test command (needs build/rocklab). Units of the run: SI.
+# check_png.py checks the picture (drawn, specimen filling the frame, cracks, legends), and the
+# same for its --section view. Run by .ci/run after the README's test command (needs
+# build/rocklab). Units of the run: SI.
 #
 # Debian's python3-paraview conflicts with python3-vtk9 (pulled in by libvtk9-dev), so this
 # installs paraview and unpacks python3-paraview into a folder of its own; pvbatch needs an X
@@ -27,3 +28,7 @@ png=${ROCKLAB_RENDER_PNG:-$out/ucs.png}
 xvfb-run -a -s "-screen 0 1600x1200x24" \
   pvbatch viz/rocklab_paraview.py "$out/ucs" --png "$png" --size 1200x900
 xvfb-run -a pvbatch tests/render/check_png.py "$png"
+# the section view: faced grains behind the axial plane, coloured by their non-affine strain
+xvfb-run -a -s "-screen 0 1600x1200x24" \
+  pvbatch viz/rocklab_paraview.py "$out/ucs" --section --png "$out/section.png" --size 1200x900
+xvfb-run -a pvbatch tests/render/check_png.py "$out/section.png"
