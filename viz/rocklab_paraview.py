@@ -9,7 +9,8 @@ Options: --at end|peak|N (the snapshot shown; default end), --color time|mode|ev
 (what colours the cracks; default time of formation), --grains (draw the grains as spheres or
 disks instead of their faced cells), --section (the faced grains behind a vertical plane through
 the specimen's axis, seen straight on and coloured by their non-affine strain: where the rock has
-come apart), --walls (show the platens), --size WxH (pixels).
+come apart), --azimuth DEG (the section plane's turn about the axis; default 0: the camera looks
+along +y), --walls (show the platens), --size WxH (pixels).
 
 What it draws (rocklab test writes the series, viz/README.md):
 - the grains' power cells (cells.pvd): 3D the specimen's skin, faded, so the fracture inside
@@ -26,6 +27,7 @@ fracture zone bright where grains moved apart or slid past their neighbours.
 The camera frames the specimen (not the platens, which are metres wide).
 """
 import json
+import math
 import os
 import sys
 
@@ -38,18 +40,20 @@ from paraview.simple import (
 def parse(argv):
     opts = {"out": os.environ.get("ROCKLAB_OUT", "."), "png": None, "frames": None, "at": "end",
             "color": "time", "grains": False, "walls": False, "section": False,
-            "size": (1600, 1200)}
+            "azimuth": 0.0, "size": (1600, 1200)}
     args = list(argv)
     positional = []
     while args:
         a = args.pop(0)
-        if a in ("--png", "--frames", "--at", "--color", "--size"):
+        if a in ("--png", "--frames", "--at", "--color", "--size", "--azimuth"):
             if not args:
                 raise SystemExit("%s needs a value" % a)
             v = args.pop(0)
             if a == "--size":
                 w, h = v.lower().split("x")
                 opts["size"] = (int(w), int(h))
+            elif a == "--azimuth":
+                opts["azimuth"] = float(v)
             else:
                 opts[a[2:]] = v
         elif a in ("--grains", "--walls", "--section"):
@@ -189,17 +193,25 @@ def upper_percentile(source, array, t, q):
     return v if v > 0 else 1.0
 
 
-def show_section(view, cells, times, dim):
+def section_view(azimuth_deg):
+    """The direction a section is seen along: +y turned by the azimuth about the axis (z)."""
+    a = math.radians(azimuth_deg)
+    return (-math.sin(a), math.cos(a), 0.0)
+
+
+def show_section(view, cells, times, dim, azimuth_deg):
     """3D: the faced grains behind the vertical plane through the axis that faces the camera
-    (the camera looks along +y); 2D: every cell. Coloured by their non-affine strain since
-    loading began."""
+    (the camera looks along section_view(azimuth)); 2D: every cell. Coloured by their non-affine
+    strain since loading began."""
     half = cells
     if dim == 3:
         b = cells.GetDataInformation().GetBounds()
+        d = section_view(azimuth_deg)
         side = Calculator(Input=cells)
         side.AttributeType = "Cell Data"
         side.ResultArrayName = "behind_axis_m"
-        side.Function = "grain_center_Y - %.17g" % (0.5 * (b[2] + b[3]))
+        side.Function = "(grain_center_X - %.17g) * %.17g + (grain_center_Y - %.17g) * %.17g" % (
+            0.5 * (b[0] + b[1]), d[0], 0.5 * (b[2] + b[3]), d[1])
         half = threshold(side, "behind_axis_m", 0.0, 1e30)
     sd = Show(half, view)
     ColorBy(sd, ("CELLS", "nonaffine_strain"))
@@ -252,7 +264,7 @@ def main(argv):
         if cells.GetCellDataInformation().GetArray("nonaffine_strain") is None:
             raise SystemExit("--section: %s/cells.pvd has no nonaffine_strain (written by rocklab"
                              " from version 0.1.0 of 2026-12-04 on)" % vtk_dir)
-        show_section(view, cells, times, dim)
+        show_section(view, cells, times, dim, o["azimuth"])
     # Grains: faced cells (3D: the skin, faded) or spheres/disks.
     elif cells is not None and not o["grains"]:
         if dim == 3:
@@ -308,9 +320,11 @@ def main(argv):
                         "axial strain %.3f %%   axial stress %.1f MPa   step %d%s") % (
             name.upper(), material, 100 * f.get("axial_strain", 0.0),
             1e-6 * f.get("axial_stress", 0.0), int(f.get("step", 0)),
-            "\nsection through the axis: the grains behind it" if section and dim == 3 else "")
+            "\nsection through the axis (azimuth %g deg): the grains behind it" % o["azimuth"]
+            if section and dim == 3 else "")
         frame_specimen(view, cells or grains, t, 2 if section else dim,
-                       facing=(0, -1, 0) if section and dim == 3 else (0, 0, 1))
+                       facing=tuple(-c for c in section_view(o["azimuth"])) if section and dim == 3
+                       else (0, 0, 1))
         Render(view)
 
     if o["frames"]:
@@ -333,7 +347,7 @@ def main(argv):
 
 def frame_specimen(view, source, t, dim, facing=(0, 0, 1)):
     """Point the camera at the specimen's bounds. dim 2: a flat view from the `facing` side
-    (+z: the 2D plane; -y: a 3D section, z up), parallel projection."""
+    (+z: the 2D plane; horizontal: a 3D section, z up), parallel projection."""
     source.UpdatePipeline(t)
     b = source.GetDataInformation().GetBounds()
     cx, cy, cz = 0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), 0.5 * (b[4] + b[5])
