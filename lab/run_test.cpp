@@ -462,7 +462,8 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
       std::printf("plot         %s/%s (and .png)\n", out_dir.c_str(), name.c_str());
     else if (name == "vtk/grains.pvd")
       std::printf("ParaView     %s/vtk/grains.pvd (also cells, contact_cracks, events, bonds, "
-                  "cracks, walls; pvpython viz/rocklab_paraview.py %s sets up the view)\n",
+                  "cracks, walls; pvpython viz/rocklab_paraview.py %s [--section] sets up the "
+                  "view)\n",
                   out_dir.c_str(), out_dir.c_str());
   }
 }
