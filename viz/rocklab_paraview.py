@@ -225,6 +225,40 @@ def show_section(view, cells, times, dim, azimuth_deg):
            % SECTION_CAP, [0.03, 0.08])
 
 
+def show_grains(view, grains, cells, times, dim, as_spheres):
+    """The grains: faced cells (3D: the skin, faded; 2D: coloured by von Mises stress) or
+    spheres/disks coloured by displacement."""
+    if cells is not None and not as_spheres:
+        if dim == 3:
+            skin = threshold(cells, "boundary", 0.5, 1.5)
+            gd = Show(skin, view)
+            gd.ColorArrayName = ["POINTS", ""]
+            gd.AmbientColor = gd.DiffuseColor = [0.62, 0.62, 0.62]
+            gd.Opacity = 0.12
+        else:
+            gd = Show(cells, view)
+            ColorBy(gd, ("CELLS", "von_mises_stress"))
+            glut = GetColorTransferFunction("von_mises_stress")
+            glut.ApplyPreset("Grayscale", True)
+            glut.InvertTransferFunction()
+            glut.RescaleTransferFunction(*series_range(cells, "CELLS", "von_mises_stress", times))
+            legend(view, glut, "grain von Mises stress [Pa]", [0.86, 0.08])
+            gd.SetRepresentationType("Surface With Edges")
+            gd.EdgeColor = [0.55, 0.55, 0.55]
+    else:
+        glyph = Glyph(Input=grains, GlyphType="Sphere")
+        glyph.ScaleArray = ["POINTS", "radius"]
+        glyph.ScaleFactor = 2.0  # the unit-diameter sphere scaled to 2 R
+        glyph.GlyphMode = "All Points"
+        gd = Show(glyph, view)
+        ColorBy(gd, ("POINTS", "displacement", "Magnitude"))
+        glut = GetColorTransferFunction("displacement")
+        glut.ApplyPreset("Grayscale", True)
+        glut.RescaleTransferFunction(*series_range(grains, "POINTS", "displacement", times))
+        legend(view, glut, "grain displacement [m]", [0.86, 0.08])
+        gd.Opacity = 0.25 if dim == 3 else 1.0
+
+
 def main(argv):
     o = parse(argv)
     vtk_dir = os.path.join(o["out"], "vtk")
@@ -265,36 +299,8 @@ def main(argv):
             raise SystemExit("--section: %s/cells.pvd has no nonaffine_strain (an older rocklab"
                              " wrote it; run the test again)" % vtk_dir)
         show_section(view, cells, times, dim, o["azimuth"])
-    # Grains: faced cells (3D: the skin, faded) or spheres/disks.
-    elif cells is not None and not o["grains"]:
-        if dim == 3:
-            skin = threshold(cells, "boundary", 0.5, 1.5)
-            gd = Show(skin, view)
-            gd.ColorArrayName = ["POINTS", ""]
-            gd.AmbientColor = gd.DiffuseColor = [0.62, 0.62, 0.62]
-            gd.Opacity = 0.12
-        else:
-            gd = Show(cells, view)
-            ColorBy(gd, ("CELLS", "von_mises_stress"))
-            glut = GetColorTransferFunction("von_mises_stress")
-            glut.ApplyPreset("Grayscale", True)
-            glut.InvertTransferFunction()
-            glut.RescaleTransferFunction(*series_range(cells, "CELLS", "von_mises_stress", times))
-            legend(view, glut, "grain von Mises stress [Pa]", [0.86, 0.08])
-            gd.SetRepresentationType("Surface With Edges")
-            gd.EdgeColor = [0.55, 0.55, 0.55]
     else:
-        glyph = Glyph(Input=grains, GlyphType="Sphere")
-        glyph.ScaleArray = ["POINTS", "radius"]
-        glyph.ScaleFactor = 2.0  # the unit-diameter sphere scaled to 2 R
-        glyph.GlyphMode = "All Points"
-        gd = Show(glyph, view)
-        ColorBy(gd, ("POINTS", "displacement", "Magnitude"))
-        glut = GetColorTransferFunction("displacement")
-        glut.ApplyPreset("Grayscale", True)
-        glut.RescaleTransferFunction(*series_range(grains, "POINTS", "displacement", times))
-        legend(view, glut, "grain displacement [m]", [0.86, 0.08])
-        gd.Opacity = 0.25 if dim == 3 else 1.0
+        show_grains(view, grains, cells, times, dim, o["grains"])
     Hide(grains, view)
 
     if cracks is not None and not section:

@@ -25,10 +25,13 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 ./build/rocklab test tests/render/ucs_3d_small.json -o "$out/ucs" -q
 png=${ROCKLAB_RENDER_PNG:-$out/ucs.png}
-xvfb-run -a -s "-screen 0 1600x1200x24" \
+# One X server for every picture (starting one per pvbatch raced: an xvfb-run once failed to
+# start its server right after the previous one stopped). The section view: faced grains behind
+# the axial plane, coloured by their non-affine strain.
+export out png
+xvfb-run -a -s "-screen 0 1600x1200x24" bash -c '
+  set -e
   pvbatch viz/rocklab_paraview.py "$out/ucs" --png "$png" --size 1200x900
-xvfb-run -a pvbatch tests/render/check_png.py "$png"
-# the section view: faced grains behind the axial plane, coloured by their non-affine strain
-xvfb-run -a -s "-screen 0 1600x1200x24" \
+  pvbatch tests/render/check_png.py "$png"
   pvbatch viz/rocklab_paraview.py "$out/ucs" --section --png "$out/section.png" --size 1200x900
-xvfb-run -a pvbatch tests/render/check_png.py "$out/section.png"
+  pvbatch tests/render/check_png.py "$out/section.png"'
