@@ -290,8 +290,8 @@ def main(argv):
     scene = GetAnimationScene()
     scene.UpdateAnimationUsingDataTimeSteps()
 
-    section = o["section"] and cells is not None
-    if o["section"] and not section:
+    section = o["section"]
+    if section and cells is None:
         raise SystemExit("--section needs the faced cells (%s/cells.pvd)" % vtk_dir)
     if section:
         cells.UpdatePipeline(times[-1] if times else None)
@@ -362,7 +362,8 @@ def frame_specimen(view, source, t, dim, facing=(0, 0, 1)):
     view.CameraFocalPoint = [cx, cy, cz]
     if dim == 2:
         up = 1 if facing[2] else 2  # the picture's vertical axis: y (2D) or z (a section)
-        across = b[1] - b[0]
+        # across the picture: x in 2D; a section's plane turns about z, so the wider of x and y
+        across = b[1] - b[0] if up == 1 else max(b[1] - b[0], b[3] - b[2])
         h = max(b[2 * up + 1] - b[2 * up], 0.8 * across)
         shift = [0.0, 0.0, 0.0]
         shift[up] = 0.05 * h  # the specimen a little low: the caption above
