@@ -26,10 +26,12 @@ trap 'rm -rf "$out"' EXIT
 ./build/rocklab test tests/render/ucs_3d_small.json -o "$out/ucs" -q
 png=${ROCKLAB_RENDER_PNG:-$out/ucs.png}
 # One X server for every picture (starting one per pvbatch raced: an xvfb-run once failed to
-# start its server right after the previous one stopped). The section view: faced grains behind
-# the axial plane, coloured by their non-affine strain.
+# start its server right after the previous one stopped). -noreset: by default Xvfb resets when its
+# last client leaves, and a pvbatch connecting during that reset aborts with "bad X server
+# connection" (seen in CI between the two pictures). The section view: faced grains behind the
+# axial plane, coloured by their non-affine strain.
 export out png
-xvfb-run -a -s "-screen 0 1600x1200x24" bash -c '
+xvfb-run -a -s "-screen 0 1600x1200x24 -noreset" bash -c '
   set -e
   pvbatch viz/rocklab_paraview.py "$out/ucs" --png "$png" --size 1200x900
   pvbatch tests/render/check_png.py "$png"
