@@ -400,7 +400,8 @@ TEST(CalibrationFile, AVariantExtendsAFileAndReplacesWholeKeys) {
   const CalibrationFile slits = load_calibration(dir + "lac_du_bonnet_slits.json");
   EXPECT_EQ(slits.name, "lac-du-bonnet-3d-slits");
   EXPECT_EQ(slits.tests, base.tests);
-  EXPECT_EQ(slits.seeds, base.seeds);
+  EXPECT_EQ(slits.seeds, (std::vector<std::uint64_t>{1, 2, 3, 4, 5, 6})); // its own key
+  EXPECT_EQ(base.seeds, (std::vector<std::uint64_t>{1, 2, 3}));
   ASSERT_EQ(slits.targets.size(), base.targets.size());
   ASSERT_EQ(slits.params.size(), base.params.size());
   EXPECT_EQ(slits.budget.ratios, 0); // its own budget, not the defaults
