@@ -6,6 +6,7 @@
 // handed to finalization (bonds where the gap is within the installation gap: the card's `gap`, or
 // `gap_ratio` times the imported grains' mean radius) and release (relaxed to equilibrium; cut if
 // the card asks). The specimen is the card's shape type at the packing's extent.
+#include "core/spatial_order.hpp"
 #include "io/input_error.hpp"
 #include "materials/genesis/stages.hpp"
 

@@ -116,11 +116,6 @@ struct Run {
   double porosity_now() const;
 };
 
-/// The order that numbers grains along a Morton (Z-order) curve of cells of size `cell` counted
-/// from `lo` (cloud.cpp): grains near each other in space end up near each other in memory.
-std::vector<std::size_t> morton_order(const std::vector<Vec3>& x, int dim, double cell,
-                                      const Vec3& lo);
-
 /// What a card's genesis will take (estimate.cpp); 0 for an imported packing.
 struct GenesisEstimate {
   double grains = 0;  ///< expected grain count

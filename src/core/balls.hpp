@@ -38,6 +38,15 @@ struct Balls {
   std::vector<Eigen::Quaterniond> orient;
 
   std::size_t size() const { return pos.size(); }
+  /// Call f(v) on every per-ball array (orient only while tracked): the one list that edits
+  /// moving or removing balls go through.
+  template <class F> void for_each_array(F&& f) {
+    f(pos), f(vel), f(spin), f(force), f(moment), f(applied_force), f(applied_moment), f(disp);
+    f(radius), f(mass), f(inertia), f(density), f(fixity), f(group), f(id), f(clump);
+    f(body_work), f(gravity_work), f(damping_work);
+    if (tracking_)
+      f(orient);
+  }
   bool tracks_orientation() const { return tracking_; }
   /// Turn tracking on (every ball starts from the identity, i.e. "now" is the reference) or off.
   void track_orientation(bool on) {

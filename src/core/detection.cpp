@@ -284,6 +284,7 @@ void Model::create_contact(std::uint64_t key) {
 
 void Model::rebuild_adjacency() {
   // Ball -> contact adjacency in contact order, for a deterministic force sum.
+  ++adjacency_generation_;
   const std::size_t n = balls.size();
   adj_start_.assign(n + 1, 0);
   for (const Contact& c : contacts_) {

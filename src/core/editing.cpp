@@ -1,6 +1,7 @@
 // Editing a model between cycles: clumps, contact-model methods and properties, the margin, and
 // removing walls or balls (contacts compacted in order, their dissipation kept in the ledger).
 #include "core/model.hpp"
+#include "core/spatial_order.hpp"
 
 #include "core/parallel.hpp"
 #include <Eigen/Eigenvalues>
@@ -188,14 +189,7 @@ void Model::remove_balls(const std::vector<bool>& remove) {
         v[j++] = v[i];
     v.resize(kept);
   };
-  compact(balls.pos), compact(balls.vel), compact(balls.spin), compact(balls.force);
-  compact(balls.moment), compact(balls.applied_force), compact(balls.applied_moment);
-  compact(balls.disp), compact(balls.radius), compact(balls.mass), compact(balls.inertia);
-  compact(balls.density), compact(balls.fixity), compact(balls.group), compact(balls.id);
-  compact(balls.clump), compact(balls.body_work), compact(balls.gravity_work);
-  compact(balls.damping_work);
-  if (balls.tracks_orientation())
-    compact(balls.orient);
+  balls.for_each_array(compact);
   mass_scale_.clear(); // density scaling ends with a change of the balls
   inertia_scale_.clear();
   // Clumps go whole or stay whole; the work of what goes stays in the group totals.
@@ -231,6 +225,48 @@ void Model::remove_balls(const std::vector<bool>& remove) {
   });
   if (initialized_)
     detect(); // rebuilds the adjacency; new candidates may appear
+}
+
+void Model::renumber_balls(const std::vector<std::size_t>& order) {
+  const std::size_t n = balls.size();
+  if (initialized_ || !contacts_.empty())
+    throw std::logic_error("renumber_balls: only before the model is initialized");
+  if (order.size() != n)
+    throw std::invalid_argument("renumber_balls: the order must name every ball once");
+  std::vector<std::int32_t> map(n, -1); // old index -> new
+  for (std::size_t k = 0; k < n; ++k) {
+    if (order[k] >= n || map[order[k]] >= 0)
+      throw std::invalid_argument("renumber_balls: the order must name every ball once");
+    map[order[k]] = static_cast<std::int32_t>(k);
+  }
+  balls.for_each_array([&](auto& v) {
+    auto moved = v;
+    for (std::size_t k = 0; k < n; ++k)
+      moved[k] = v[order[k]];
+    v = std::move(moved);
+  });
+  for (Clump& c : clumps)
+    for (std::int32_t& p : c.pebbles)
+      p = map[static_cast<std::size_t>(p)];
+  mass_scale_.clear();
+  inertia_scale_.clear();
+}
+
+bool Model::renumber_spatially() {
+  const std::size_t n = balls.size();
+  if (n < kRenumberMin)
+    return false;
+  double r_sum = 0, step_sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    r_sum += balls.radius[i];
+    if (i > 0)
+      step_sum += (balls.pos[i] - balls.pos[i - 1]).norm();
+  }
+  const double r_avg = r_sum / static_cast<double>(n);
+  if (step_sum / static_cast<double>(n - 1) <= kOrderedStep * r_avg)
+    return false; // already near spatial order: keep the user's numbering
+  renumber_balls(morton_order(balls.pos, settings.dim, 2 * r_avg));
+  return true;
 }
 
 } // namespace rocklab

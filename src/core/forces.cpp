@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <omp.h>
 #include <sstream>
 
 namespace rocklab {
@@ -16,19 +15,19 @@ namespace rocklab {
 using namespace detail;
 
 void Model::force_displacement(double dt) {
-  const std::size_t nc = contacts_.size();
   const std::size_t none = std::numeric_limits<std::size_t>::max();
   std::size_t blowup = none;
   for (auto& buf : thread_events_)
     buf.clear();
-#pragma omp parallel reduction(min : blowup) if (nc >= kParallelMin)
-  {
-    EventBuffer& events = thread_events_[static_cast<std::size_t>(omp_get_thread_num())];
-#pragma omp for schedule(static)
-    for (std::size_t ci = 0; ci < nc; ++ci)
-      if (!update_contact_force(ci, dt, events))
+  const ThreadPlan& plan = plan_threads();
+  for_ranges(plan.contact, [&](std::size_t t, std::size_t begin, std::size_t end) {
+    EventBuffer& events = thread_events_[t];
+    for (std::size_t ci = begin; ci < end; ++ci)
+      if (!update_contact_force(ci, dt, events)) {
+#pragma omp critical(rocklab_blowup)
         blowup = std::min(blowup, ci);
-  }
+      }
+  });
   // Events in a fixed order: by contact, then by the order a contact raised them.
   const std::size_t before = pending_events_.size();
   for (auto& buf : thread_events_)
@@ -151,30 +150,36 @@ void Model::book_events(std::size_t first) {
 
 double Model::sum_ball_forces() {
   // Each ball sums its contacts in contact order; returns the stiffness-limited time step.
-  const std::size_t n = balls.size();
-  double dt_min = std::numeric_limits<double>::infinity();
-#pragma omp parallel for schedule(static) reduction(min : dt_min) if (n >= kParallelMin)
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec3 F = Vec3::Zero(), M = Vec3::Zero();
-    double k_tran = 0, k_rot = 0;
-    const Vec3& xi = balls.pos[i];
-    for (std::int32_t a = adj_start_[i]; a < adj_start_[i + 1]; ++a) {
-      const std::int32_t item = adj_items_[static_cast<std::size_t>(a)];
-      const ContactOutput& c = outputs_[static_cast<std::size_t>(item >> 1)];
-      const double side = (item & 1) ? 1.0 : -1.0; // force acts on end2, reaction on end1
-      const Vec3 f = side * c.force;
-      const Vec3 arm = c.xc - xi;
-      F += f;
-      M += side * c.moment + arm.cross(f);
-      add_ball_stiffness(c.stiff, arm, k_tran, k_rot);
+  const ThreadPlan& plan = plan_threads();
+  range_parts_.resize(plan.threads);
+  for_ranges(plan.ball, [&](std::size_t t, std::size_t begin, std::size_t end) {
+    double dt_min = std::numeric_limits<double>::infinity();
+    for (std::size_t i = begin; i < end; ++i) {
+      Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+      double k_tran = 0, k_rot = 0;
+      const Vec3& xi = balls.pos[i];
+      for (std::int32_t a = adj_start_[i]; a < adj_start_[i + 1]; ++a) {
+        const std::int32_t item = adj_items_[static_cast<std::size_t>(a)];
+        const ContactOutput& c = outputs_[static_cast<std::size_t>(item >> 1)];
+        const double side = (item & 1) ? 1.0 : -1.0; // force acts on end2, reaction on end1
+        const Vec3 f = side * c.force;
+        const Vec3 arm = c.xc - xi;
+        F += f;
+        M += side * c.moment + arm.cross(f);
+        add_ball_stiffness(c.stiff, arm, k_tran, k_rot);
+      }
+      balls.force[i] = F;
+      balls.moment[i] = M;
+      if (k_tran > 0)
+        dt_min = std::min(dt_min, std::sqrt(inertial_mass(i) / k_tran));
+      if (k_rot > 0)
+        dt_min = std::min(dt_min, std::sqrt(inertial_inertia(i) / k_rot));
     }
-    balls.force[i] = F;
-    balls.moment[i] = M;
-    if (k_tran > 0)
-      dt_min = std::min(dt_min, std::sqrt(inertial_mass(i) / k_tran));
-    if (k_rot > 0)
-      dt_min = std::min(dt_min, std::sqrt(inertial_inertia(i) / k_rot));
-  }
+    range_parts_[t][0] = dt_min;
+  });
+  double dt_min = std::numeric_limits<double>::infinity();
+  for (std::size_t t = 0; t < plan.threads; ++t)
+    dt_min = std::min(dt_min, range_parts_[t][0]);
   return dt_min;
 }
 

@@ -8,6 +8,7 @@
 #include "core/contact.hpp"
 #include "core/energy.hpp"
 #include "core/events.hpp"
+#include "core/thread_plan.hpp"
 #include "core/walls.hpp"
 
 #include <array>
@@ -134,6 +135,17 @@ public:
   void remove_walls(const std::vector<bool>& remove);
   /// Give contact `ci` a new model (material finalization, joint insertion).
   void replace_contact_model(std::size_t ci, const ModelProps& props);
+  /// Renumber the balls before initialize(): order[k] is the index of the ball that goes to place
+  /// k (every per-ball array and the clumps' pebbles follow; ids stay). Throws std::logic_error
+  /// once the model is initialized.
+  void renumber_balls(const std::vector<std::size_t>& order);
+  /// Renumber the balls along a Morton curve (spatial_order.hpp) before initialize() when their
+  /// order is poor: at least kRenumberMin balls whose consecutive centres lie on average more
+  /// than kOrderedStep mean radii apart (a packing sorted by size, or shuffled). Then the cycle's
+  /// threads share few grains (ThreadPlan). Returns whether it renumbered; ids stay.
+  bool renumber_spatially();
+  static constexpr std::size_t kRenumberMin = 1024;
+  static constexpr double kOrderedStep = 8.0;
   /// Remove the balls flagged in `remove` and their contacts (cutting a specimen, floaters).
   void remove_balls(const std::vector<bool>& remove);
   /// Average stress tensor of the balls in `volume` [m^3] (2D: area x unit thickness) from the
@@ -171,6 +183,8 @@ public:
 private:
   void ensure_thread_buffers();
   void rebuild_adjacency();
+  /// Bring plan_ up to date with the balls, contacts and thread count (model.cpp).
+  const detail::ThreadPlan& plan_threads();
   void retire_dissipation(const Contact& c);
   void move_clumps(double dt, std::array<double, 4>& sums);
   /// Add `share` of a contact's energies to the group ledgers (sharing rule).
@@ -215,6 +229,16 @@ private:
   std::vector<std::int32_t> cell_start_, cell_items_;
   std::vector<std::int32_t> adj_start_, adj_items_; // ball -> contacts (index*2 + side)
   std::vector<std::int32_t> adj_cursor_;
+  std::uint64_t adjacency_generation_ = 0; ///< counts rebuild_adjacency calls
+  detail::ThreadPlan plan_;
+  std::vector<std::array<double, 4>> motion_parts_; ///< per-block sums of the law of motion
+  /// What one ball's step adds to the ledger (motion.cpp), kept where two threads share a block.
+  struct BallWork {
+    std::array<double, 6> constraint{}; ///< work of each fixed DOF's constraint [J]
+    double body = 0, gravity = 0, damping = 0;
+  };
+  std::vector<BallWork> motion_spill_;             ///< the shared blocks' per-ball records
+  std::vector<std::array<double, 4>> range_parts_; ///< per-thread-range results of a loop
   std::vector<EventBuffer> thread_events_;
   std::vector<Event> pending_events_;
 

@@ -91,58 +91,71 @@ void Model::law_of_motion(double dt) {
   const bool track = balls.tracks_orientation();
   // acc: 0 body work, 1 gravity work, 2 boundary (constraint) work, 3 local damping, 4 max |v|
   // and 5 max displacement are handled with separate reductions below.
-  auto sums = block_sum<4>(balls.size(), [&](std::size_t i, std::array<double, 4>& acc) {
-    if (balls.clump[i] >= 0)
-      return; // pebbles move with their clump (move_clumps)
-    const double m = inertial_mass(i);
-    double bw = 0, gw = 0, dw = 0; // this ball's body, gravity and damping work
-    const std::uint8_t fix = balls.fixity[i];
-    const Vec3 Fg = balls.mass[i] * gvec; // gravity acts on the true mass
-    const Vec3 Fbody = Fg + balls.applied_force[i];
-    const Vec3 F = balls.force[i] + Fbody;
-    Vec3& v = balls.vel[i];
-    for (int d = 0; d < ntran; ++d) {
-      const double v0 = v[d];
-      double v1 = v0;
-      if (fix & dof_bit(d)) {
-        acc[2] -= F[d] * v0 * dt; // the constraint force -F holds the velocity
-      } else {
-        const double Fd = -alpha * std::abs(F[d]) * sign(v0);
-        v1 = v0 + (F[d] + Fd) / m * dt;
-        dw -= Fd * 0.5 * (v0 + v1) * dt;
-      }
-      v[d] = v1;
-      bw += Fbody[d] * 0.5 * (v0 + v1) * dt; // Eq. 2
-      gw += Fg[d] * 0.5 * (v0 + v1) * dt;    // Eq. 3
-    }
-    const double I = inertial_inertia(i);
-    const Vec3 M = balls.moment[i] + balls.applied_moment[i];
-    Vec3& w = balls.spin[i];
-    for (int d = (dim == 2 ? 2 : 0); d < 3; ++d) {
-      const double w0 = w[d];
-      double w1 = w0;
-      if (fix & dof_bit(3 + d)) {
-        acc[2] -= M[d] * w0 * dt;
-      } else {
-        const double Md = -alpha * std::abs(M[d]) * sign(w0);
-        w1 = w0 + (M[d] + Md) / I * dt;
-        dw -= Md * 0.5 * (w0 + w1) * dt;
-      }
-      w[d] = w1;
-      bw += balls.applied_moment[i][d] * 0.5 * (w0 + w1) * dt;
-    }
-    if (track) // turned by the mid-step spin, as the position is moved by the mid-step velocity
-      balls.orient[i] = turn_by(balls.orient[i], w * dt);
-    const Vec3 dx = v * dt;
-    balls.pos[i] += dx;
-    balls.disp[i] += dx;
-    acc[0] += bw;
-    acc[1] += gw;
-    acc[3] += dw;
-    balls.body_work[i] += bw;
-    balls.gravity_work[i] += gw;
-    balls.damping_work[i] += dw;
-  });
+  // What a ball's step adds to the ledger, in the order block_sum's accumulator took it: the
+  // constraint work of each fixed DOF (translations, then rotations; +0 for a free one leaves the
+  // sum unchanged), then the body, gravity and damping work.
+  auto add = [](std::array<double, 4>& acc, const BallWork& r) {
+    for (double c : r.constraint)
+      acc[2] -= c;
+    acc[0] += r.body;
+    acc[1] += r.gravity;
+    acc[3] += r.damping;
+  };
+  auto sums = plan_block_sum<4>(
+      plan_threads(), motion_spill_, motion_parts_,
+      [&](std::size_t i) {
+        BallWork r;
+        if (balls.clump[i] >= 0)
+          return r; // pebbles move with their clump (move_clumps)
+        const double m = inertial_mass(i);
+        double bw = 0, gw = 0, dw = 0; // this ball's body, gravity and damping work
+        const std::uint8_t fix = balls.fixity[i];
+        const Vec3 Fg = balls.mass[i] * gvec; // gravity acts on the true mass
+        const Vec3 Fbody = Fg + balls.applied_force[i];
+        const Vec3 F = balls.force[i] + Fbody;
+        Vec3& v = balls.vel[i];
+        for (int d = 0; d < ntran; ++d) {
+          const double v0 = v[d];
+          double v1 = v0;
+          if (fix & dof_bit(d)) {
+            r.constraint[static_cast<std::size_t>(d)] = F[d] * v0 * dt; // -F holds the velocity
+          } else {
+            const double Fd = -alpha * std::abs(F[d]) * sign(v0);
+            v1 = v0 + (F[d] + Fd) / m * dt;
+            dw -= Fd * 0.5 * (v0 + v1) * dt;
+          }
+          v[d] = v1;
+          bw += Fbody[d] * 0.5 * (v0 + v1) * dt; // Eq. 2
+          gw += Fg[d] * 0.5 * (v0 + v1) * dt;    // Eq. 3
+        }
+        const double I = inertial_inertia(i);
+        const Vec3 M = balls.moment[i] + balls.applied_moment[i];
+        Vec3& w = balls.spin[i];
+        for (int d = (dim == 2 ? 2 : 0); d < 3; ++d) {
+          const double w0 = w[d];
+          double w1 = w0;
+          if (fix & dof_bit(3 + d)) {
+            r.constraint[static_cast<std::size_t>(3 + d)] = M[d] * w0 * dt;
+          } else {
+            const double Md = -alpha * std::abs(M[d]) * sign(w0);
+            w1 = w0 + (M[d] + Md) / I * dt;
+            dw -= Md * 0.5 * (w0 + w1) * dt;
+          }
+          w[d] = w1;
+          bw += balls.applied_moment[i][d] * 0.5 * (w0 + w1) * dt;
+        }
+        if (track) // turned by the mid-step spin, as the position is moved by the mid-step velocity
+          balls.orient[i] = turn_by(balls.orient[i], w * dt);
+        const Vec3 dx = v * dt;
+        balls.pos[i] += dx;
+        balls.disp[i] += dx;
+        balls.body_work[i] += bw;
+        balls.gravity_work[i] += gw;
+        balls.damping_work[i] += dw;
+        r.body = bw, r.gravity = gw, r.damping = dw;
+        return r;
+      },
+      add);
   move_clumps(dt, sums);
   ledger_.body_work += sums[0];
   ledger_.gravity_work += sums[1];
@@ -154,21 +167,30 @@ void Model::law_of_motion(double dt) {
 void Model::track_motion(double dt) {
   // The largest speed and displacement since detection (time step, detection trigger), and the
   // blow-up checks: a ball moving more than its radius in a step, a non-finite state.
+  const std::size_t n = balls.size();
+  const ThreadPlan& plan = plan_threads();
+  range_parts_.resize(plan.threads);
+  for_ranges(plan.ball, [&](std::size_t t, std::size_t begin, std::size_t end) {
+    double vmax = 0, dmax = 0, step_ratio = 0;
+    bool bad = false;
+    for (std::size_t i = begin; i < end; ++i) {
+      vmax = std::max(vmax, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
+      // A ball that moves more than its radius or turns more than a radian in one step.
+      step_ratio = std::max(
+          {step_ratio, balls.vel[i].norm() * dt / balls.radius[i], balls.spin[i].norm() * dt});
+      dmax = std::max(dmax, balls.disp[i].norm());
+      bad = bad || !balls.pos[i].allFinite() || !balls.vel[i].allFinite() ||
+            !balls.spin[i].allFinite();
+    }
+    range_parts_[t] = {vmax, dmax, step_ratio, bad ? 1.0 : 0.0};
+  });
   double vmax = 0, dmax = 0, step_ratio = 0;
   bool bad = false;
-  const std::size_t n = balls.size();
-#pragma omp parallel for schedule(static) reduction(max                                            \
-                                                    : vmax, dmax, step_ratio)                      \
-    reduction(||                                                                                   \
-              : bad) if (n >= kParallelMin)
-  for (std::size_t i = 0; i < n; ++i) {
-    vmax = std::max(vmax, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
-    // A ball that moves more than its radius or turns more than a radian in one step.
-    step_ratio = std::max(
-        {step_ratio, balls.vel[i].norm() * dt / balls.radius[i], balls.spin[i].norm() * dt});
-    dmax = std::max(dmax, balls.disp[i].norm());
-    bad =
-        bad || !balls.pos[i].allFinite() || !balls.vel[i].allFinite() || !balls.spin[i].allFinite();
+  for (std::size_t t = 0; t < plan.threads; ++t) {
+    vmax = std::max(vmax, range_parts_[t][0]);
+    dmax = std::max(dmax, range_parts_[t][1]);
+    step_ratio = std::max(step_ratio, range_parts_[t][2]);
+    bad = bad || range_parts_[t][3] != 0;
   }
   max_speed_ = vmax;
   max_ball_disp_ = dmax;

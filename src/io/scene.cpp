@@ -217,6 +217,10 @@ Scene load_scene(const std::string& path) {
 
   read_walls(top, m);
   read_balls(top, m);
+  // Grains far from spatial order (another code's packing sorted by size, a shuffled list) are
+  // renumbered along a Morton curve so that the cycle's threads share few of them; every output
+  // names grains by their ids, and ball ids in the rest of the scene are looked up after this.
+  m.renumber_spatially();
   read_surface(top, m);
   read_contact_models(top, m);
 
