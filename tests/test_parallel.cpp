@@ -65,11 +65,14 @@ struct Snapshot {
   std::size_t contacts = 0, events = 0;
 };
 
-Snapshot run_with_threads(int threads, std::int64_t cycles) {
+Snapshot run_with_threads(int threads, std::int64_t cycles,
+                          const std::vector<double>& shares = {}) {
   const int before = omp_get_max_threads();
   omp_set_num_threads(threads);
   Model m = bonded_block(3000, true);
   m.renumber_spatially();
+  if (!shares.empty())
+    m.set_thread_shares(shares);
   m.initialize();
   m.cycle(cycles);
   std::vector<Event> ev;
@@ -96,6 +99,18 @@ TEST(Parallel, AThreeThousandGrainBondedBlockGivesTheSameBitsAtOneTwoAndThreeThr
     EXPECT_TRUE(one.spin == other.spin) << threads << " threads: spins differ";
     EXPECT_TRUE(one.energy == other.energy) << threads << " threads: energies differ";
   }
+}
+
+// The shares follow the threads' measured speeds, so a plan can be anything: a lopsided one (a
+// thread with 90 % of the work, its boundary inside a reduction block) gives the same bits too.
+TEST(Parallel, LopsidedThreadSharesGiveTheSameBits) {
+  const Snapshot even = run_with_threads(2, 150);
+  const Snapshot lopsided = run_with_threads(2, 150, {0.9, 0.1});
+  const Snapshot three = run_with_threads(3, 150, {0.2, 0.05, 0.75});
+  EXPECT_TRUE(even.pos == lopsided.pos && even.vel == lopsided.vel && even.spin == lopsided.spin);
+  EXPECT_TRUE(even.energy == lopsided.energy);
+  EXPECT_TRUE(even.pos == three.pos && even.vel == three.vel && even.energy == three.energy);
+  EXPECT_THROW(Model().set_thread_shares({1.0, 0.0}), std::invalid_argument);
 }
 
 TEST(Parallel, AShuffledPackingIsRenumberedAlongAMortonCurveKeepingIdsAndPhysics) {

@@ -298,8 +298,11 @@ void Model::rebuild_adjacency() {
   {
     std::vector<std::int32_t>& cursor = adj_cursor_; // reused: no allocation once sized
     cursor.assign(adj_start_.begin(), adj_start_.end() - 1);
+    facet_contacts_.clear();
     for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
       const Contact& c = contacts_[ci];
+      if (c.kind == ContactKind::BallFacet)
+        facet_contacts_.push_back(static_cast<std::int32_t>(ci));
       adj_items_[static_cast<std::size_t>(cursor[static_cast<std::size_t>(c.end1)]++)] =
           static_cast<std::int32_t>(2 * ci);
       if (c.kind == ContactKind::BallBall)

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <omp.h>
 #include <sstream>
 
 namespace rocklab {
@@ -21,13 +22,17 @@ void Model::force_displacement(double dt) {
     buf.clear();
   const ThreadPlan& plan = plan_threads();
   for_ranges(plan.contact, [&](std::size_t t, std::size_t begin, std::size_t end) {
+    const double start = omp_get_wtime();
     EventBuffer& events = thread_events_[t];
     for (std::size_t ci = begin; ci < end; ++ci)
       if (!update_contact_force(ci, dt, events)) {
 #pragma omp critical(rocklab_blowup)
         blowup = std::min(blowup, ci);
       }
+    if (static_cast<std::size_t>(omp_get_num_threads()) == plan.threads)
+      time_range(t, omp_get_wtime() - start); // each range on its own thread: speeds compare
   });
+  balance_threads();
   // Events in a fixed order: by contact, then by the order a contact raised them.
   const std::size_t before = pending_events_.size();
   for (auto& buf : thread_events_)
@@ -189,10 +194,9 @@ void Model::sum_wall_forces() {
     w.moment.setZero();
     w.radial_force = 0;
   }
-  for (std::size_t ci = 0; ci < contacts_.size(); ++ci) {
+  for (const std::int32_t item : facet_contacts_) { // in contact order, as the whole list
+    const std::size_t ci = static_cast<std::size_t>(item);
     const Contact& c = contacts_[ci];
-    if (c.kind != ContactKind::BallFacet)
-      continue;
     const ContactOutput& o = outputs_[ci];
     Wall& w = walls[static_cast<std::size_t>(c.end2)];
     w.force += o.force;

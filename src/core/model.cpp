@@ -30,52 +30,6 @@ void Model::ensure_thread_buffers() {
     thread_keys_.resize(nthreads);
 }
 
-const ThreadPlan& Model::plan_threads() {
-  const std::size_t T = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
-  const std::size_t n = balls.size(), nc = contacts_.size();
-  ThreadPlan& p = plan_;
-  if (p.threads == T && p.balls == n && p.contacts == nc && p.generation == adjacency_generation_)
-    return p;
-  p.threads = T;
-  p.balls = n;
-  p.contacts = nc;
-  p.generation = adjacency_generation_;
-  p.ball.assign(T + 1, n);
-  p.contact.assign(T + 1, nc);
-  p.ball[0] = p.contact[0] = 0;
-  // The first contact whose first end is ball i or later (the list is sorted by first end).
-  auto first_contact = [&](std::size_t i) {
-    return static_cast<std::size_t>(std::partition_point(contacts_.begin(), contacts_.end(),
-                                                         [&](const Contact& c) {
-                                                           return static_cast<std::size_t>(c.end1) <
-                                                                  i;
-                                                         }) -
-                                    contacts_.begin());
-  };
-  // Work of balls [0, i): a contact update costs many ball updates (kContactWork).
-  constexpr std::size_t kContactWork = 16;
-  auto work = [&](std::size_t i) { return i + kContactWork * first_contact(i); };
-  const std::size_t total = work(n);
-  std::size_t chunk = 0;
-  const std::size_t chunks = (n + kChunk - 1) / kChunk;
-  for (std::size_t t = 1; t < T; ++t) {
-    while (chunk < chunks && work(std::min(n, chunk * kChunk)) * T < total * t)
-      ++chunk;
-    p.ball[t] = std::min(n, chunk * kChunk);
-    p.contact[t] = first_contact(p.ball[t]);
-  }
-  p.shared_blocks.clear();
-  p.shared_slot.assign((n + kBlock - 1) / kBlock, -1);
-  for (std::size_t t = 1; t < T; ++t) {
-    const std::size_t blk = p.ball[t] / kBlock;
-    if (p.ball[t] % kBlock != 0 && p.ball[t] < n && p.shared_slot[blk] < 0) {
-      p.shared_slot[blk] = static_cast<std::int32_t>(p.shared_blocks.size());
-      p.shared_blocks.push_back(blk);
-    }
-  }
-  return p;
-}
-
 void Model::initialize() {
   ensure_thread_buffers();
   for (auto& w : walls)

@@ -145,6 +145,9 @@ public:
   /// threads share few grains (ThreadPlan). Returns whether it renumbered; ids stay.
   bool renumber_spatially();
   static constexpr std::size_t kRenumberMin = 1024;
+  /// The fraction of the cycle's work each OpenMP thread starts with (normalized; by default
+  /// equal). The shares then follow the threads' measured speed; results never depend on them.
+  void set_thread_shares(const std::vector<double>& shares);
   static constexpr double kOrderedStep = 8.0;
   /// Remove the balls flagged in `remove` and their contacts (cutting a specimen, floaters).
   void remove_balls(const std::vector<bool>& remove);
@@ -183,8 +186,12 @@ public:
 private:
   void ensure_thread_buffers();
   void rebuild_adjacency();
-  /// Bring plan_ up to date with the balls, contacts and thread count (model.cpp).
+  /// Bring plan_ up to date with the balls, contacts and thread count (thread_plan.cpp).
   const detail::ThreadPlan& plan_threads();
+  /// Book the time range t of the contact loop took; after some steps, move the shares towards
+  /// the threads' measured speeds (thread_plan.cpp).
+  void time_range(std::size_t t, double seconds);
+  void balance_threads();
   void retire_dissipation(const Contact& c);
   void move_clumps(double dt, std::array<double, 4>& sums);
   /// Add `share` of a contact's energies to the group ledgers (sharing rule).
@@ -229,7 +236,8 @@ private:
   std::vector<std::int32_t> cell_start_, cell_items_;
   std::vector<std::int32_t> adj_start_, adj_items_; // ball -> contacts (index*2 + side)
   std::vector<std::int32_t> adj_cursor_;
-  std::uint64_t adjacency_generation_ = 0; ///< counts rebuild_adjacency calls
+  std::vector<std::int32_t> facet_contacts_; ///< ball-facet contacts in contact order (walls' sums)
+  std::uint64_t adjacency_generation_ = 0;   ///< counts rebuild_adjacency calls
   detail::ThreadPlan plan_;
   std::vector<std::array<double, 4>> motion_parts_; ///< per-block sums of the law of motion
   /// What one ball's step adds to the ledger (motion.cpp), kept where two threads share a block.
