@@ -78,15 +78,18 @@ void BM_LinearDense3D_20k(benchmark::State& state) {
 
 // The bonded models on the same packing: bonds installed at every contact, strengths high
 // enough that nothing breaks (this measures the elastic cycle).
-void BM_PBondDense3D_20k(benchmark::State& state) {
+LinearPBondProps pb_bench_props(double emod, double kratio) {
   LinearPBondProps p;
-  p.linear.emod = 1e9;
-  p.linear.kratio = 1.5;
+  p.linear.emod = p.pb_emod = emod;
+  p.linear.kratio = p.pb_kratio = kratio;
   p.linear.fric = 0.5;
-  p.pb_emod = 1e9;
-  p.pb_kratio = 1.5;
   p.pb_ten = p.pb_coh = 1e12;
   p.bond = true;
+  return p;
+}
+
+void BM_PBondDense3D_20k(benchmark::State& state) {
+  LinearPBondProps p = pb_bench_props(1e9, 1.5);
   p.bond_gap_hi = 1e-4;
   static Model m = dense_packing(20000, p);
   run_cycles(state, m);
@@ -196,14 +199,7 @@ void run_packing(benchmark::State& state, Model& m) {
 }
 
 LinearPBondProps pb_packing_props() {
-  LinearPBondProps p;
-  p.linear.emod = 7e10;
-  p.linear.kratio = 2.0;
-  p.linear.fric = 0.5;
-  p.pb_emod = 7e10;
-  p.pb_kratio = 2.0;
-  p.pb_ten = p.pb_coh = 1e12;
-  p.bond = true;
+  LinearPBondProps p = pb_bench_props(7e10, 2.0);
   p.bond_gap_ratio = true;
   p.bond_gap_hi = 0.1;
   return p;
@@ -218,20 +214,21 @@ FlatJointProps fj_packing_props() {
   return p;
 }
 
-void BM_PBondPacking10k(benchmark::State& state) {
+// One model per order and contact model, made at its first case.
+template <class Props> void run_packing_order(benchmark::State& state, Props (*props)()) {
   static std::map<std::int64_t, Model> models;
   const std::int64_t order = state.range(1);
   if (!models.count(order))
-    models.emplace(order, packing_model(static_cast<Order>(order), pb_packing_props()));
+    models.emplace(order, packing_model(static_cast<Order>(order), props()));
   run_packing(state, models.at(order));
 }
 
+void BM_PBondPacking10k(benchmark::State& state) {
+  run_packing_order(state, pb_packing_props);
+}
+
 void BM_FlatJoint8Packing10k(benchmark::State& state) {
-  static std::map<std::int64_t, Model> models;
-  const std::int64_t order = state.range(1);
-  if (!models.count(order))
-    models.emplace(order, packing_model(static_cast<Order>(order), fj_packing_props()));
-  run_packing(state, models.at(order));
+  run_packing_order(state, fj_packing_props);
 }
 
 // The bare-kernel ceiling: the contact law alone (the model's update and its stiffness, what
