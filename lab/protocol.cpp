@@ -77,6 +77,8 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     else if (l.has("jaw_radius_ratio"))
       l.fail("jaw_radius_ratio", "applies to \"jaws\": \"curved\" only");
     p.density_scaling = l.number("density_scaling", Range::half_open(0, 1), 0.0);
+    if (l.has("timestep_safety"))
+      p.timestep_safety = l.number("timestep_safety", {0, 1.6, true, false}, std::nullopt);
     if (l.has("platen_friction"))
       p.platen_friction = l.number("platen_friction", Range::closed(0, 10), std::nullopt);
     test->check_loading(l, p);

@@ -42,6 +42,9 @@ struct Protocol {
   /// > 0: density scaling from the start of loading, the time step raised to this quantile of
   /// the grains' own stable steps (Model::scale_density); 0: off.
   double density_scaling = 0;
+  /// > 0: the factor on the automatic time step from the start of loading (replaces the
+  /// specimen's, Settings::timestep_safety); 0: the specimen's.
+  double timestep_safety = 0;
   // stop
   double post_peak_fraction = 0.9; ///< stop when the load falls to this fraction of its peak
   std::int64_t min_steps = 1000;   ///< ... but not before this many loading steps

@@ -1,9 +1,16 @@
 #include "lab/suite_jobs.hpp"
 
+#include "core/thread_lease.hpp"
+
+#include <algorithm>
+#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <map>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 
@@ -16,7 +23,84 @@ extern char** environ;
 
 namespace rocklab {
 
+std::vector<int> share_cores(int cores, std::size_t running) {
+  std::vector<int> share(running, 1);
+  if (running == 0 || static_cast<std::size_t>(cores) <= running)
+    return share;
+  const int n = static_cast<int>(running);
+  for (int k = 0; k < n; ++k)
+    share[static_cast<std::size_t>(k)] = cores / n + (k >= n - cores % n ? 1 : 0);
+  return share;
+}
+
 namespace {
+
+// The leases of this process's children (src/core/thread_lease.hpp), in start order: the cores
+// shared out among the processes that run now, across every run_jobs call of the process (a
+// calibration runs several suites at once in threads).
+class CoreBroker {
+public:
+  static CoreBroker& get() {
+    static CoreBroker b;
+    return b;
+  }
+  /// A child about to start: its lease file, holding its share of the cores (also in `threads`).
+  std::string join(int& threads) {
+    std::lock_guard<std::mutex> lock(mu_);
+    const std::string file =
+        (std::filesystem::temp_directory_path() /
+         ("rocklab-lease-" + std::to_string(getpid()) + "-" + std::to_string(serial_++)))
+            .string();
+    leases_.push_back({file, 0});
+    lend_pending_ = false; // the new shares include the cores of any that ended
+    share_out();
+    threads = leases_.back().threads;
+    return file;
+  }
+  /// A child ended: its cores go to the others once no process has started for a second (a
+  /// suite starts its next test within milliseconds; lending the core for that moment would
+  /// oversubscribe it while the lent process lets go).
+  void leave(const std::string& file) {
+    std::lock_guard<std::mutex> lock(mu_);
+    std::erase_if(leases_, [&](const Lease& l) { return l.file == file; });
+    std::error_code ec;
+    std::filesystem::remove(file, ec);
+    left_ = std::chrono::steady_clock::now();
+    lend_pending_ = true;
+  }
+  /// Called often by every run_jobs loop: lends the cores of ended children when it is time.
+  void tick() {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (lend_pending_ && std::chrono::steady_clock::now() - left_ > std::chrono::seconds(1)) {
+      lend_pending_ = false;
+      share_out();
+    }
+  }
+
+private:
+  struct Lease {
+    std::string file;
+    int threads;
+  };
+  void share_out() {
+    const std::vector<int> share = share_cores(cores_, leases_.size());
+    for (std::size_t k = 0; k < leases_.size(); ++k) {
+      if (leases_[k].threads == share[k])
+        continue;
+      leases_[k].threads = share[k];
+      const std::string tmp = leases_[k].file + ".new"; // the child never reads half a file
+      std::ofstream(tmp) << share[k] << "\n";
+      std::error_code ec;
+      std::filesystem::rename(tmp, leases_[k].file, ec);
+    }
+  }
+  std::mutex mu_;
+  std::vector<Lease> leases_;
+  std::chrono::steady_clock::time_point left_;
+  bool lend_pending_ = false;
+  int cores_ = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  unsigned serial_ = 0;
+};
 
 pid_t spawn(const Job& j) {
   posix_spawn_file_actions_t fa;
@@ -27,8 +111,18 @@ pid_t spawn(const Job& j) {
   for (const std::string& a : j.argv)
     args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
+  std::vector<std::string> env_text;
+  for (char** e = environ; *e != nullptr; ++e)
+    if (std::strncmp(*e, "ROCKLAB_THREAD_LEASE=", 21) != 0)
+      env_text.emplace_back(*e);
+  if (!j.lease.empty())
+    env_text.push_back("ROCKLAB_THREAD_LEASE=" + j.lease);
+  std::vector<char*> env;
+  for (std::string& e : env_text)
+    env.push_back(e.data());
+  env.push_back(nullptr);
   pid_t pid = -1;
-  const int rc = posix_spawn(&pid, args[0], &fa, nullptr, args.data(), environ);
+  const int rc = posix_spawn(&pid, args[0], &fa, nullptr, args.data(), env.data());
   posix_spawn_file_actions_destroy(&fa);
   if (rc != 0)
     throw std::runtime_error("cannot start " + j.argv[0] + ": " + std::strerror(rc));
@@ -50,8 +144,21 @@ void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
   };
   while (next < jobs.size() || running > 0) {
     while (!stopping && running < static_cast<std::size_t>(parallel) && next < jobs.size()) {
-      jobs[next].start = std::chrono::steady_clock::now();
-      jobs[next].pid = spawn(jobs[next]);
+      Job& j = jobs[next];
+      j.start = std::chrono::steady_clock::now();
+      const auto threads_arg = std::find(j.argv.begin(), j.argv.end(), std::string("--threads"));
+      if (o.threads == 0 && threads_arg != j.argv.end() && threads_arg + 1 != j.argv.end()) {
+        int threads = 1;
+        j.lease = CoreBroker::get().join(threads);
+        *(threads_arg + 1) = std::to_string(threads);
+      }
+      try {
+        j.pid = spawn(j);
+      } catch (...) {
+        if (!j.lease.empty())
+          CoreBroker::get().leave(j.lease);
+        throw;
+      }
       live[jobs[next].pid] = next;
       ++running;
       ++next;
@@ -67,6 +174,8 @@ void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
     if (pid > 0) {
       Job& j = jobs[live[pid]];
       live.erase(pid);
+      if (!j.lease.empty())
+        CoreBroker::get().leave(j.lease);
       --running;
       j.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
       j.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - j.start).count();
@@ -84,6 +193,7 @@ void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
     }
     if (o.interrupt && o.interrupt->load())
       stop();
+    CoreBroker::get().tick();
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
   if (stopping)

@@ -427,3 +427,36 @@ TEST(Cli, NewContactsCanBeBondedByAFractionOfTheRadiiSum) {
     EXPECT_NE(msg.find("within [-1, 1]"), std::string::npos) << msg;
   }
 }
+
+TEST(Cli, ALentCoreChangesNothingButTheWallTime) {
+  // A suite or calibration lends idle cores to its running processes through a lease file
+  // (src/core/thread_lease.hpp); the run follows it between one and two threads mid-run and must
+  // give the same bits as a run on one thread throughout.
+  const std::string scene = source_dir() + "/examples/settling_2k.json";
+  const fs::path a = scratch("lease-fixed"), b = scratch("lease-lent");
+  const fs::path lease = rocklab::test::scratch_root() / "rocklab-test-lease";
+  std::ofstream(lease) << "2\n";
+  std::string out;
+  ASSERT_EQ(run_command(binary() + " run " + scene + " -o " + a.string() + " --threads 1 -q", &out),
+            0)
+      << out;
+  const std::string flip = "(for i in 1 2 3 4 5 6 7 8 9 10 11 12; do echo $((i % 2 + 1)) > " +
+                           lease.string() + ".new; mv " + lease.string() + ".new " +
+                           lease.string() + "; sleep 0.25; done) & ";
+  ASSERT_EQ(run_command("sh -c '" + flip + "ROCKLAB_THREAD_LEASE=" + lease.string() + " " +
+                            binary() + " run " + scene + " -o " + b.string() +
+                            " --threads 1 -q; s=$?; wait; exit $s'",
+                        &out),
+            0)
+      << out;
+  EXPECT_EQ(read_file(a / "results.json"), read_file(b / "results.json"));
+  EXPECT_EQ(read_file(a / "history.csv"), read_file(b / "history.csv"));
+  // ... and it does follow the lease: started on one thread, it ends on the two lent to it.
+  std::ofstream(lease) << "2\n";
+  ASSERT_EQ(run_command("ROCKLAB_THREAD_LEASE=" + lease.string() + " " + binary() + " run " +
+                            scene + " -o " + scratch("lease-two").string() + " --threads 1",
+                        &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("on 2 thread(s)"), std::string::npos) << out;
+}

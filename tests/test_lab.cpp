@@ -1001,3 +1001,45 @@ TEST(Lab, CheckpointResumeIsByteIdenticalAndSigintLeavesACheckpointOrNothing) {
       EXPECT_EQ(test::read_file(out / f), test::read_file(full / f)) << f;
   }
 }
+
+TEST(Lab, SuiteProcessesShareTheCoresAsTheyStartAndEnd) {
+  // share_cores: equal shares in start order, the remainder to the latest started, one at least.
+  EXPECT_EQ(share_cores(2, 1), (std::vector<int>{2}));
+  EXPECT_EQ(share_cores(2, 2), (std::vector<int>{1, 1}));
+  EXPECT_EQ(share_cores(2, 3), (std::vector<int>{1, 1, 1}));
+  EXPECT_EQ(share_cores(8, 3), (std::vector<int>{2, 3, 3}));
+  EXPECT_EQ(share_cores(4, 0), (std::vector<int>{}));
+  // run_jobs lends a job its share through its --threads argument and its lease file, and the
+  // cores of a job that ended to the one still running; with fixed threads there is no lease.
+  const fs::path dir = test::scratch_root() / "lease";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  auto job = [&](const std::string& name, const std::string& script) {
+    Job j;
+    j.label = name;
+    j.argv = {"/bin/sh", "-c", script, "sh", "--threads", "99"};
+    j.log = (dir / (name + ".log")).string();
+    return j;
+  };
+  const std::string d = dir.string();
+  std::vector<Job> jobs{
+      job("long", "echo $2 > " + d + "/long.arg; sleep 0.5; cat \"$ROCKLAB_THREAD_LEASE\" > " + d +
+                      "/long.during; sleep 2.5; cat \"$ROCKLAB_THREAD_LEASE\" > " + d +
+                      "/long.after"),
+      job("short", "echo $2 > " + d + "/short.arg; sleep 1")};
+  SuiteOptions o;
+  run_jobs(jobs, 2, o);
+  ASSERT_EQ(jobs[0].status, 0);
+  ASSERT_EQ(jobs[1].status, 0);
+  const int cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  auto number = [&](const char* f) { return std::stoi(test::read_file(dir / f)); };
+  EXPECT_EQ(number("long.arg"), share_cores(cores, 1)[0]); // alone when it started
+  EXPECT_EQ(number("short.arg"), share_cores(cores, 2)[1]);
+  EXPECT_EQ(number("long.during"), share_cores(cores, 2)[0]);
+  EXPECT_EQ(number("long.after"), cores);  // the short job's cores came to it a second after
+  EXPECT_FALSE(fs::exists(jobs[0].lease)); // the lease files are gone
+  o.threads = 3;
+  std::vector<Job> fixed{job("fixed", "echo $2 \"$ROCKLAB_THREAD_LEASE\" > " + d + "/fixed.arg")};
+  run_jobs(fixed, 1, o);
+  EXPECT_EQ(test::read_file(dir / "fixed.arg"), "99 \n");
+}

@@ -11,21 +11,11 @@
 #include <cstdlib>
 #include <filesystem>
 
-#include <sys/resource.h>
-
 namespace fs = std::filesystem;
 
 namespace rocklab::calibration {
 
 namespace {
-
-// CPU seconds of the finished child processes (the tests) of this process.
-double children_cpu_seconds() {
-  rusage u{};
-  getrusage(RUSAGE_CHILDREN, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
 
 // One single-seed run per parameter, that parameter moved by +10 % (-10 % at its upper bound;
 // by a tenth of its bounds when it is 0), against the same seed at the optimum.
@@ -67,14 +57,16 @@ void print_progress(int n, Stage s, const CalibrationFile& c, const Evaluation& 
     } else {
       ++unmeasured;
     }
-  char tail[64] = "";
+  char tail[64] = "", cpu[48] = "";
   if (unmeasured > 0)
     std::snprintf(tail, sizeof tail, " (%d target(s) not measured)", unmeasured);
+  if (e.cpu_utilisation >= 0)
+    std::snprintf(cpu, sizeof cpu, ", CPU %.0f %% of %d cores", 100 * e.cpu_utilisation, e.cores);
   std::fprintf(stderr,
                "[rocklab calibrate] %d %s:%s; worst %.2f tolerances%s; %zu seed(s), %d cached, "
-               "%.0f s\n",
+               "%.0f s%s\n",
                n, stage_name(s), line.c_str(), worst, tail, e.folders.size(), e.cached,
-               std::chrono::duration<double>(took).count());
+               std::chrono::duration<double>(took).count(), cpu);
 }
 
 } // namespace

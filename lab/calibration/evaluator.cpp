@@ -8,15 +8,25 @@
 #include "materials/material_card.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
 #include <thread>
 
+#include <sys/resource.h>
+
 namespace fs = std::filesystem;
 
 namespace rocklab::calibration {
+
+double children_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 nlohmann::json Evaluator::tests_of(Stage s) const {
   if (s == Stage::Ratios || s == Stage::Final)
@@ -53,7 +63,10 @@ void Evaluator::run_suites(const nlohmann::json& card, const std::vector<const R
         so.out_dir = (r.dir / "suite").string();
         fs::remove_all(so.out_dir); // a rejected earlier attempt's files
         so.executable = o_.executable;
-        so.threads = std::max(1, cores / jobs);
+        // Cores left idle (the last seed's suite alone, a suite's last test) are lent to the
+        // processes still running (lab/suite_jobs.hpp); several MPI ranks may share a machine,
+        // so there each process keeps its fixed share.
+        so.threads = o_.ranks && o_.ranks->size() > 1 ? std::max(1, cores / jobs) : 0;
         so.interrupt = o_.interrupt;
         run_suite(load_suite((r.dir / "suite.json").string()), so);
       } catch (...) {
@@ -152,6 +165,8 @@ Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_
     if (missing[i] == '1' && static_cast<int>(k++ % size) == rank)
       mine.push_back(&reps[i]);
   std::exception_ptr failed;
+  const auto wall0 = std::chrono::steady_clock::now();
+  const double cpu0 = children_cpu_seconds();
   try {
     run_suites(card, mine);
   } catch (...) {
@@ -165,6 +180,12 @@ Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_
   if (o_.interrupt && o_.interrupt->load())
     throw std::runtime_error("interrupted");
   Evaluation ev;
+  ev.cores = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  if (!mine.empty()) {
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    ev.cpu_utilisation = (children_cpu_seconds() - cpu0) / (std::max(wall, 1e-9) * ev.cores);
+  }
   std::map<std::string, std::vector<double>> all;
   for (std::size_t i = 0; i < reps.size(); ++i) {
     (missing[i] == '1' ? run_ : ev.cached) += 1;

@@ -29,7 +29,14 @@ struct Evaluation {
   Measured mean, sd;
   std::vector<std::string> folders; ///< the suites' output folders, one per seed
   int cached = 0;                   ///< seeds found in the cache
+  /// CPU time of the test processes this rank ran for it over (wall time x cores), [0, 1];
+  /// -1 when every seed came from the cache.
+  double cpu_utilisation = -1;
+  int cores = 1; ///< the cores of this rank's machine
 };
+
+/// CPU seconds of the finished child processes (the tests) of this process.
+double children_cpu_seconds();
 
 /// Adds to `ev` the mean and sample standard deviation of each property over the seeds that
 /// measured it (non-finite values are left out; NaN when none did); returns the properties some

@@ -85,6 +85,8 @@ const char* LoadingFrame::phase_name() const {
 }
 
 void LoadingFrame::begin_loading() {
+  if (p_.timestep_safety > 0)
+    m_.settings.timestep_safety = p_.timestep_safety;
   if (p_.density_scaling > 0)
     density_ = m_.scale_density(p_.density_scaling);
   phase_ = kLoad;
@@ -458,6 +460,7 @@ nlohmann::json LoadingFrame::results() const {
   r["peak_time_s"] = peak_.time;
   r["loading_rate"] = {{"platen_velocity_m_per_s", v_final_},
                        {"strain_rate_per_s", 2 * v_final_ / geo_.loaded_length()}};
+  r["timestep_safety"] = m_.settings.timestep_safety;
   if (p_.density_scaling > 0)
     r["density_scaling"] = {
         {"quantile", density_.quantile},

@@ -3,6 +3,7 @@
 #include "core/model.hpp"
 
 #include "core/parallel.hpp"
+#include "core/thread_lease.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -55,6 +56,7 @@ void Model::initialize() {
 void Model::cycle(std::int64_t count) {
   if (!initialized_)
     initialize();
+  follow_thread_lease(); // a parent running several processes may lend or take back cores
   ensure_thread_buffers();
   if (mass_scale_.size() != balls.size() && !mass_scale_.empty()) { // balls added or removed
     mass_scale_.clear();
