@@ -170,41 +170,75 @@ TEST(DensityScaling, ASavedModelKeepsItsScaling) {
   EXPECT_FALSE(m->density_scaled());
 }
 
+namespace {
+// A UCS on the small 3D flat-jointed card with these loading keys; its results.json.
+nlohmann::json run_small_ucs(const std::string& name, const nlohmann::json& loading,
+                             int expect_status = 0, std::string* msg_out = nullptr) {
+  namespace fs = std::filesystem;
+  nlohmann::json p = {
+      {"test", "ucs"},
+      {"units", "SI"},
+      {"specimen", {{"material", test::source_dir() + "/tests/data/lab_3d_fj.json"}}},
+      {"output", {{"vtk", false}, {"plots", false}}}};
+  if (!loading.empty())
+    p["loading"] = loading;
+  const fs::path file = test::scratch_root() / (name + ".json");
+  std::ofstream(file) << p.dump(2);
+  const fs::path out = test::scratch_root() / name;
+  fs::remove_all(out);
+  std::string msg;
+  EXPECT_EQ(test::run_command(
+                test::binary() + " test " + file.string() + " -o " + out.string() + " -q", &msg),
+            expect_status)
+      << msg;
+  if (msg_out)
+    *msg_out = msg;
+  if (expect_status != 0)
+    return {};
+  return nlohmann::json::parse(test::read_file(out / "results.json"));
+}
+double loading_steps(const nlohmann::json& r) {
+  return r["peak_step"].get<double>() - r["load_start_step"].get<double>();
+}
+} // namespace
+
 TEST(DensityScaling, AUcsTestTakesFewerStepsForTheSameElasticResponse) {
   // The small 3D flat-jointed card, UCS with and without `loading.density_scaling`: a longer step
   // (results.json says by how much), fewer loading steps to the peak, the same E and nu.
-  namespace fs = std::filesystem;
   auto run = [](const std::string& name, double quantile) {
-    nlohmann::json p = {
-        {"test", "ucs"},
-        {"units", "SI"},
-        {"specimen", {{"material", test::source_dir() + "/tests/data/lab_3d_fj.json"}}},
-        {"output", {{"vtk", false}, {"plots", false}}}};
-    if (quantile > 0)
-      p["loading"] = {{"density_scaling", quantile}};
-    const fs::path file = test::scratch_root() / (name + ".json");
-    std::ofstream(file) << p.dump(2);
-    const fs::path out = test::scratch_root() / name;
-    fs::remove_all(out);
-    std::string msg;
-    EXPECT_EQ(test::run_command(
-                  test::binary() + " test " + file.string() + " -o " + out.string() + " -q", &msg),
-              0)
-        << msg;
-    return nlohmann::json::parse(test::read_file(out / "results.json"));
+    return run_small_ucs(name, quantile > 0 ? nlohmann::json{{"density_scaling", quantile}}
+                                            : nlohmann::json::object());
   };
   const nlohmann::json ref = run("ds_ref", 0), fast = run("ds_fast", 0.5);
   EXPECT_FALSE(ref.contains("density_scaling"));
   ASSERT_TRUE(fast.contains("density_scaling"));
   const double gain = fast["density_scaling"]["timestep_gain"].get<double>();
   EXPECT_GT(gain, 1.1);
-  auto loading_steps = [](const nlohmann::json& r) {
-    return r["peak_step"].get<double>() - r["load_start_step"].get<double>();
-  };
   EXPECT_LT(loading_steps(fast), loading_steps(ref) / 1.1);
   EXPECT_TRUE(near_rel(fast["youngs_modulus_Pa"].get<double>(),
                        ref["youngs_modulus_Pa"].get<double>(), 0.01));
   EXPECT_NEAR(fast["poisson_ratio"].get<double>(), ref["poisson_ratio"].get<double>(), 0.01);
   EXPECT_TRUE(
       near_rel(fast["peak_stress_Pa"].get<double>(), ref["peak_stress_Pa"].get<double>(), 0.05));
+}
+
+TEST(DensityScaling, ALargerStepFactorForTheLoadingTakesFewerSteps) {
+  // `loading.timestep_safety` replaces the specimen's factor (0.8) from the start of loading:
+  // results.json reports it, the loading takes about 0.8/1.2 of the steps to the peak, and the
+  // elastic response and the strength stay (docs/results.md, "Time-step factor"); outside
+  // (0, 1.6] it is an input error naming the key and the range.
+  const nlohmann::json ref = run_small_ucs("dt_ref", nlohmann::json::object());
+  const nlohmann::json fast = run_small_ucs("dt_fast", {{"timestep_safety", 1.2}});
+  EXPECT_EQ(ref["timestep_safety"].get<double>(), 0.8);
+  EXPECT_EQ(fast["timestep_safety"].get<double>(), 1.2);
+  EXPECT_EQ(fast["load_start_step"], ref["load_start_step"]); // the seating kept its step
+  EXPECT_LT(loading_steps(fast), loading_steps(ref) / 1.3);
+  EXPECT_TRUE(near_rel(fast["youngs_modulus_Pa"].get<double>(),
+                       ref["youngs_modulus_Pa"].get<double>(), 0.01));
+  EXPECT_TRUE(
+      near_rel(fast["peak_stress_Pa"].get<double>(), ref["peak_stress_Pa"].get<double>(), 0.05));
+  std::string msg;
+  run_small_ucs("dt_bad", {{"timestep_safety", 1.7}}, 2, &msg);
+  EXPECT_NE(msg.find("loading.timestep_safety"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("1.6"), std::string::npos) << msg;
 }
