@@ -3,7 +3,6 @@
 #include "core/thread_lease.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <cstring>
@@ -12,6 +11,7 @@
 #include <map>
 #include <mutex>
 #include <stdexcept>
+#include <string_view>
 #include <thread>
 
 #include <fcntl.h>
@@ -111,12 +111,14 @@ pid_t spawn(const Job& j) {
   for (const std::string& a : j.argv)
     args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
+  // The child's environment: this one's, with the child's own lease (or none).
+  const std::string lease_key = std::string(kThreadLeaseEnv) + "=";
   std::vector<std::string> env_text;
   for (char** e = environ; *e != nullptr; ++e)
-    if (std::strncmp(*e, "ROCKLAB_THREAD_LEASE=", 21) != 0)
+    if (std::string_view(*e).substr(0, lease_key.size()) != lease_key)
       env_text.emplace_back(*e);
   if (!j.lease.empty())
-    env_text.push_back("ROCKLAB_THREAD_LEASE=" + j.lease);
+    env_text.push_back(lease_key + j.lease);
   std::vector<char*> env;
   for (std::string& e : env_text)
     env.push_back(e.data());
@@ -159,7 +161,7 @@ void run_jobs(std::vector<Job>& jobs, int parallel, const SuiteOptions& o) {
           CoreBroker::get().leave(j.lease);
         throw;
       }
-      live[jobs[next].pid] = next;
+      live[j.pid] = next;
       ++running;
       ++next;
     }

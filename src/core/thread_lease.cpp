@@ -6,10 +6,15 @@
 #include <cstdlib>
 #include <omp.h>
 
+#include <string>
+
 namespace rocklab {
 
-int read_thread_lease(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "r");
+namespace {
+
+// The thread count a lease file holds, or 0 when it cannot be read or is out of [1, 1024].
+int read_thread_lease(const char* path) {
+  std::FILE* f = std::fopen(path, "r");
   if (!f)
     return 0;
   int n = 0;
@@ -19,8 +24,10 @@ int read_thread_lease(const std::string& path) {
   return n;
 }
 
+} // namespace
+
 void follow_thread_lease() {
-  static const char* const path = std::getenv("ROCKLAB_THREAD_LEASE");
+  static const char* const path = std::getenv(std::string(kThreadLeaseEnv).c_str());
   if (path == nullptr || *path == '\0')
     return;
   using clock = std::chrono::steady_clock;

@@ -7,15 +7,15 @@
 // core changes only the wall time.
 #pragma once
 
-#include <string>
+#include <string_view>
 
 namespace rocklab {
+
+/// The environment variable naming a process's lease file (set by the parent for each child).
+inline constexpr std::string_view kThreadLeaseEnv = "ROCKLAB_THREAD_LEASE";
 
 /// Follow the lease, if this process has one: set OpenMP's thread count to the file's value when
 /// it changed. Cheap when there is no lease or the last look was under 0.2 s ago.
 void follow_thread_lease();
-
-/// The thread count a lease file holds, or 0 when it cannot be read or is out of [1, 1024].
-int read_thread_lease(const std::string& path);
 
 } // namespace rocklab
