@@ -35,17 +35,9 @@ SpecimenSource obtain_specimen(const Protocol& p, const std::atomic<bool>* inter
   }
   MaterialCard card =
       named_by(p.file, "specimen.material", [&] { return load_material_card(p.material_file); });
-  apply_overrides(card,
-                  {{p.shape, p.file, "specimen.shape"}, {p.cut, p.file, "specimen.cut"}, p.seed});
-  ProgressLine line("genesis", progress);
-  GenesisResult g = run_genesis(
-      card,
-      [&](const std::string& s) {
-        if (line.due())
-          line.show(s);
-      },
-      interrupt);
-  line.finish();
+  GenesisResult g = genesis_with_overrides(
+      card, {{p.shape, p.file, "specimen.shape"}, {p.cut, p.file, "specimen.cut"}, p.seed},
+      progress, interrupt);
   src.meta = specimen_meta(card, g.report);
   src.model = std::move(g.model);
   return src;

@@ -2,6 +2,7 @@
 // report. Units SI.
 #include "materials/genesis.hpp"
 
+#include "io/progress.hpp"
 #include "materials/genesis/stages.hpp"
 
 #include <chrono>
@@ -135,6 +136,21 @@ GenesisResult run_genesis(const MaterialCard& card,
   }
   rep.seconds = std::chrono::duration<double>(clock::now() - t0).count();
   return {std::move(out), rep};
+}
+
+GenesisResult genesis_with_overrides(MaterialCard& card, const GenesisOverrides& o, bool progress,
+                                     const std::atomic<bool>* interrupt) {
+  apply_overrides(card, o);
+  ProgressLine line("genesis", progress);
+  GenesisResult g = run_genesis(
+      card,
+      [&](const std::string& phase) {
+        if (line.due())
+          line.show(phase);
+      },
+      interrupt);
+  line.finish();
+  return g;
 }
 
 } // namespace rocklab

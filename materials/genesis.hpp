@@ -50,4 +50,10 @@ GenesisResult run_genesis(const MaterialCard& card,
                           const std::function<void(const std::string&)>& progress = {},
                           const std::atomic<bool>* interrupt = nullptr);
 
+/// The one path from a card to a specimen, for `rocklab genesis` and a protocol's
+/// `specimen.material`: the overrides applied to the card (a bad shape fails naming where it was
+/// given), then genesis with a "genesis" progress line on stderr when `progress`.
+GenesisResult genesis_with_overrides(MaterialCard& card, const GenesisOverrides& o, bool progress,
+                                     const std::atomic<bool>* interrupt);
+
 } // namespace rocklab

@@ -127,17 +127,28 @@ void apply_overrides(MaterialCard& card, const GenesisOverrides& o) {
 
 namespace {
 
-LinearProps read_linear(JsonObject o) {
-  LinearProps p;
-  if (o.has("emod")) {
-    p.emod = o.number("emod", Range::positive(), std::nullopt, "Pa");
-    p.kratio = o.number("kratio", Range::non_negative(), 0.0);
-  } else {
-    p.kn = o.number("kn", Range::positive(), std::nullopt, "N/m");
-    p.ks = o.number("ks", Range::non_negative(), 0.0, "N/m");
-  }
-  p.fric = o.number("fric", Range::non_negative(), 0.0);
-  o.finish();
+// A card section holding a contact model's properties: its model keys are read by the model's own
+// reader, the one a scene's contact_models entry uses (one reader, one default per key:
+// docs/scene-format.md); the card reads its own keys (`card_keys`: per-contact distributions,
+// types) itself. In a bond section every model key carries the model's prefix: the bond's
+// linear part is the card's `linear` section, and the bond itself is installed by genesis.
+template <class M>
+typename M::Props read_model_section(JsonObject& top, const std::string& section, int dim,
+                                     const std::string& prefix,
+                                     std::initializer_list<const char*> card_keys) {
+  JsonObject s = top.object(section);
+  nlohmann::json model_keys = top.raw(section); // an object (top.object checked it)
+  for (const char* k : card_keys)
+    model_keys.erase(k);
+  for (auto it = model_keys.begin(); it != model_keys.end(); ++it)
+    if (!prefix.empty() && it.key().rfind(prefix, 0) != 0)
+      s.fail(it.key(), "is not a key of a card's '" + section + "' section (its keys start with '" +
+                           prefix +
+                           "'; the linear part is the card's 'linear' section and "
+                           "genesis installs the bonds)");
+  JsonObject m(model_keys, s.file(), s.path());
+  typename M::Props p = M::read(m, dim);
+  m.finish();
   return p;
 }
 
@@ -233,18 +244,17 @@ void read_bonding(JsonObject& top, MaterialCard& c) {
     top.fail("flatjoint", "give one of 'flatjoint', 'parallelbond' or 'contactbond'");
   if (top.has("flatjoint")) {
     c.bonding = MaterialCard::Bonding::FlatJoint;
+    c.fj = read_model_section<FlatJoint>(top, "flatjoint", c.dim, "fj_",
+                                         {"fj_ten", "fj_coh", "types"});
     JsonObject f = top.object("flatjoint");
-    c.fj.fj_Nr = static_cast<int>(f.integer("fj_Nr", 1, 1000, c.dim == 2 ? 4 : 2));
-    if (c.dim == 3)
-      c.fj.fj_Nal = static_cast<int>(f.integer("fj_Nal", 3, 1000, 4));
-    c.fj.fj_rmul = f.number("fj_rmul", Range::positive(), 1.0);
-    c.fj.fj_emod = f.number("fj_emod", Range::positive(), std::nullopt, "Pa");
-    c.fj.fj_kratio = f.number("fj_kratio", Range::non_negative(), std::nullopt);
-    c.fj.fj_fric = f.number("fj_fric", Range::non_negative(), 0.0);
-    c.fj.fj_fa = f.number("fj_fa", Range::half_open(0, 90), 0.0, "deg");
+    if (!(c.fj.fj_emod > 0 || c.fj.fj_kn > 0))
+      f.fail("fj_emod", "missing: a card's flat joints need a stiffness (fj_emod with fj_kratio, "
+                        "or fj_kn with fj_ks)");
+    if (f.has("fj_gap0"))
+      f.fail("fj_gap0", "is set by genesis on a card: give the gapped contacts' gap as "
+                        "'types.gap'");
     c.fj_ten = read_dist(f, "fj_ten", "Pa");
     c.fj_coh = read_dist(f, "fj_coh", "Pa");
-    c.fj.fj_exact = f.boolean("fj_exact", false);
     JsonObject t = f.optional_object("types");
     c.frac_bonded = t.number("bonded", Range::closed(0, 1), 1.0);
     c.frac_gapped = t.number("gapped", Range::closed(0, 1), 0.0);
@@ -255,18 +265,15 @@ void read_bonding(JsonObject& top, MaterialCard& c) {
     if (c.frac_gapped > 0)
       c.gapped_gap = read_dist(t, "gap", "m");
     t.finish();
-    f.finish();
   } else if (top.has("parallelbond")) {
     c.bonding = MaterialCard::Bonding::ParallelBond;
+    c.pb = read_model_section<LinearPBond>(top, "parallelbond", c.dim, "pb_", {"pb_ten", "pb_coh"});
     JsonObject p = top.object("parallelbond");
-    c.pb.pb_rmul = p.number("pb_rmul", Range::positive(), 1.0);
-    c.pb.pb_emod = p.number("pb_emod", Range::positive(), std::nullopt, "Pa");
-    c.pb.pb_kratio = p.number("pb_kratio", Range::non_negative(), std::nullopt);
-    c.pb.pb_mcf = p.number("pb_mcf", Range::closed(0, 1), 1.0);
-    c.pb.pb_fa = p.number("pb_fa", Range::half_open(0, 90), 0.0, "deg");
+    if (!(c.pb.pb_emod > 0 || c.pb.pb_kn > 0))
+      p.fail("pb_emod", "missing: a card's parallel bonds need a stiffness (pb_emod with "
+                        "pb_kratio, or pb_kn with pb_ks)");
     c.pb_ten = read_dist(p, "pb_ten", "Pa");
     c.pb_coh = read_dist(p, "pb_coh", "Pa");
-    p.finish();
   } else if (top.has("contactbond")) {
     // PFC's contact bond on the linear contact: point-bond strengths in force units.
     c.bonding = MaterialCard::Bonding::ContactBond;
@@ -338,7 +345,7 @@ MaterialCard load_material_card(const std::string& path) {
   if (!c.packing_import.empty() && c.clump_max > 0)
     top.fail("clumps", "clumped grains are made by packing; they cannot be combined with an "
                        "imported packing ('packing.import')");
-  c.linear = read_linear(top.object("linear"));
+  c.linear = read_model_section<Linear>(top, "linear", c.dim, "", {});
   read_bonding(top, c);
   read_joints(top, c, path);
   top.finish();

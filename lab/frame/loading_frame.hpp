@@ -132,13 +132,11 @@ public:
   const std::vector<LabSample>& samples() const { return samples_; }
   const LabSample& current() const { return current_; }
   const PeakRecord& peak() const { return peak_; }
-  const nlohmann::json& specimen_meta() const { return meta_; }
   double load_ref() const { return load_ref_; } ///< load when loading began [Pa]
   /// The change of every energy term since loading began (since the test began before it) [J].
   EnergyLedger energy_since_loading() const;
   double sep_ref() const { return sep_ref_; }         ///< separation when loading began [m]
   double separation() const;                          ///< platen or grip separation [m]
-  double platen_velocity() const { return v_final_; } ///< while loading [m/s]
   std::int64_t load_start_step() const { return load_start_step_; }
   std::int64_t reverse_step() const { return reverse_step_; }
   bool confined() const { return !lateral_.empty(); }
@@ -166,7 +164,6 @@ public:
   void snapshot_taken() { snapshot_due_ = false; }
   bool peak_snapshot_due() const { return peak_snap_due_; }
   void peak_snapshot_taken() { peak_snap_due_ = false; }
-  int phase() const { return phase_; }
   const char* phase_name() const;
   const std::vector<Vec3>& reference_positions() const { return reference_; }
 

@@ -1,7 +1,6 @@
 // rocklab command-line interface. All quantities in input and output files are SI.
 #include "contact/model_json.hpp"
 #include "io/output_dir.hpp"
-#include "io/progress.hpp"
 #include "io/scene.hpp"
 #include "io/scene_run.hpp"
 #include "io/specimen.hpp"
@@ -79,16 +78,7 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
                                       std::nullopt};
   if (seed >= 0)
     overrides.seed = static_cast<std::uint64_t>(seed);
-  rocklab::apply_overrides(card, overrides);
-  rocklab::ProgressLine progress("genesis", !quiet);
-  rocklab::GenesisResult g = rocklab::run_genesis(
-      card,
-      [&](const std::string& phase) {
-        if (progress.due())
-          progress.show(phase);
-      },
-      &g_interrupt);
-  progress.finish();
+  rocklab::GenesisResult g = rocklab::genesis_with_overrides(card, overrides, !quiet, &g_interrupt);
   if (g_interrupt.load())
     throw std::runtime_error("interrupted; no specimen was written");
   const nlohmann::json report = g.report.to_json();

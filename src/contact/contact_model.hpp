@@ -183,6 +183,20 @@ struct BondOption {
 /// `default_bond` (model_json.cpp).
 BondOption read_bond_option(JsonObject& p, bool default_bond, double default_hi = 0);
 
+/// A model's stiffnesses as its properties give them: either the stiffnesses themselves
+/// (`<prefix>kn`, `<prefix>ks`) or the deformability (`<prefix>emod`, `<prefix>kratio`; FJ memo
+/// Eq. 40, LPB doc 2.2), never both. One reader for every model (model_json.cpp); kratio is 0 (no
+/// shear stiffness, the docs' default) or at least 1e-3 (it divides).
+struct StiffnessPair {
+  double kn = 0, ks = 0;       ///< given stiffnesses [k_unit]
+  double emod = 0, kratio = 0; ///< deformability: effective modulus [Pa], kn/ks [-]
+  bool deformability = false;  ///< emod was given
+};
+StiffnessPair read_stiffness_pair(JsonObject& p, const std::string& prefix, const char* k_unit,
+                                  bool kn_required);
+/// Lower bound of a radius multiplier (fj_rmul, pb_rmul): a factor the contact divides by.
+inline constexpr double kMinRadiusMultiplier = 1e-3;
+
 /// What a creation gap is measured against: 1 (metres) or, for a `gap_ratio` range, the radii
 /// sum R1 + R2 (a ball-facet contact: R1), as the run-stage methods' `gap_ratio` does.
 inline double bond_gap_scale(const CreationInfo& ci, bool ratio) {

@@ -426,18 +426,10 @@ FlatJoint::Props FlatJoint::read(JsonObject& p, int dim) {
   fj.fj_Nal = static_cast<int>(p.integer("fj_Nal", 3, 1000, 4));
   if (dim == 2 && p.has("fj_Nal"))
     p.fail("fj_Nal", "is a 3D property (2D flat joints have fj_Nr elements only)");
-  fj.fj_rmul = p.number("fj_rmul", Range::positive(), 1.0);
+  fj.fj_rmul = p.number("fj_rmul", Range::at_least(kMinRadiusMultiplier), 1.0);
   fj.fj_gap0 = p.number("fj_gap0", Range::non_negative(), 0.0, "m");
-  const bool deform = p.has("fj_emod");
-  if (deform && (p.has("fj_kn") || p.has("fj_ks")))
-    p.fail("fj_emod", "give either fj_kn/fj_ks or fj_emod/fj_kratio, not both");
-  if (deform) {
-    fj.fj_emod = p.number("fj_emod", Range::positive(), std::nullopt, "Pa");
-    fj.fj_kratio = p.number("fj_kratio", Range::non_negative(), 0.0);
-  } else {
-    fj.fj_kn = p.number("fj_kn", Range::non_negative(), 0.0, "Pa/m");
-    fj.fj_ks = p.number("fj_ks", Range::non_negative(), 0.0, "Pa/m");
-  }
+  const StiffnessPair k = read_stiffness_pair(p, "fj_", "Pa/m", false);
+  fj.fj_kn = k.kn, fj.fj_ks = k.ks, fj.fj_emod = k.emod, fj.fj_kratio = k.kratio;
   fj.fj_fric = p.number("fj_fric", Range::non_negative(), 0.0);
   fj.fj_ten = p.number("fj_ten", Range::non_negative(), 0.0, "Pa");
   fj.fj_coh = p.number("fj_coh", Range::non_negative(), 0.0, "Pa");

@@ -77,18 +77,10 @@ void shear_update(double ks, double fric, double Fn, double& Fss, double& Fst, d
 
 LinearProps read_props(JsonObject& p, bool kn_required) {
   LinearProps lp;
-  const bool deform = p.has("emod");
-  if (deform && (p.has("kn") || p.has("ks")))
-    p.fail("emod", "give either the stiffnesses kn/ks or the deformability emod/kratio, not both");
-  if (deform) {
-    lp.emod = p.number("emod", Range::positive(), std::nullopt, "Pa");
-    lp.kratio = p.number("kratio", Range::non_negative(), 0.0);
+  const StiffnessPair k = read_stiffness_pair(p, "", "N/m", kn_required);
+  lp.kn = k.kn, lp.ks = k.ks, lp.emod = k.emod, lp.kratio = k.kratio;
+  if (k.deformability)
     lp.user_area = p.number("user_area", Range::non_negative(), 0.0, "m^2");
-  } else {
-    lp.kn = p.number("kn", Range::non_negative(),
-                     kn_required ? std::nullopt : std::optional<double>(0.0), "N/m");
-    lp.ks = p.number("ks", Range::non_negative(), 0.0, "N/m");
-  }
   lp.fric = p.number("fric", Range::non_negative(), 0.0);
   lp.rgap = p.number("rgap", Range::any(), 0.0, "m");
   lp.lin_mode = static_cast<int>(p.integer("lin_mode", 0, 1, 0));

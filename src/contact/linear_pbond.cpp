@@ -172,17 +172,9 @@ ContactEnergy LinearPBond::energy(const Contact& c) {
 LinearPBond::Props LinearPBond::read(JsonObject& p, int) {
   Props pb;
   pb.linear = linear::read_props(p, false);
-  pb.pb_rmul = p.number("pb_rmul", Range::positive(), 1.0);
-  const bool deform = p.has("pb_emod");
-  if (deform && (p.has("pb_kn") || p.has("pb_ks")))
-    p.fail("pb_emod", "give either pb_kn/pb_ks or pb_emod/pb_kratio, not both");
-  if (deform) {
-    pb.pb_emod = p.number("pb_emod", Range::positive(), std::nullopt, "Pa");
-    pb.pb_kratio = p.number("pb_kratio", Range::non_negative(), 0.0);
-  } else {
-    pb.pb_kn = p.number("pb_kn", Range::non_negative(), 0.0, "Pa/m");
-    pb.pb_ks = p.number("pb_ks", Range::non_negative(), 0.0, "Pa/m");
-  }
+  pb.pb_rmul = p.number("pb_rmul", Range::at_least(kMinRadiusMultiplier), 1.0);
+  const StiffnessPair k = read_stiffness_pair(p, "pb_", "Pa/m", false);
+  pb.pb_kn = k.kn, pb.pb_ks = k.ks, pb.pb_emod = k.emod, pb.pb_kratio = k.kratio;
   pb.pb_mcf = p.number("pb_mcf", Range::closed(0, 1), 1.0);
   pb.pb_ten = p.number("pb_ten", Range::non_negative(), 0.0, "Pa");
   pb.pb_coh = p.number("pb_coh", Range::non_negative(), 0.0, "Pa");

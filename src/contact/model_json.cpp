@@ -34,6 +34,29 @@ BondOption read_bond_option(JsonObject& p, bool default_bond, double default_hi)
   return b;
 }
 
+StiffnessPair read_stiffness_pair(JsonObject& p, const std::string& prefix, const char* k_unit,
+                                  bool kn_required) {
+  const std::string kn = prefix + "kn", ks = prefix + "ks", emod = prefix + "emod",
+                    kratio = prefix + "kratio";
+  StiffnessPair s;
+  s.deformability = p.has(emod);
+  if (s.deformability && (p.has(kn) || p.has(ks)))
+    p.fail(emod, "give either the stiffnesses " + kn + "/" + ks + " or the deformability " + emod +
+                     "/" + kratio + ", not both");
+  if (s.deformability) {
+    s.emod = p.number(emod, Range::positive(), std::nullopt, "Pa");
+    s.kratio = p.number(kratio, Range::non_negative(), 0.0);
+    if (s.kratio > 0 && s.kratio < 1e-3)
+      p.fail(kratio, "value " + std::to_string(s.kratio) +
+                         " is out of range: 0 (no shear stiffness) or [0.001, +inf)");
+  } else {
+    s.kn = p.number(kn, Range::non_negative(), kn_required ? std::nullopt : std::optional(0.0),
+                    k_unit);
+    s.ks = p.number(ks, Range::non_negative(), 0.0, k_unit);
+  }
+  return s;
+}
+
 std::vector<std::string> model_names(ModelUse use) {
   std::vector<std::string> names;
   for_each_model([&]<class M>() {

@@ -31,6 +31,9 @@ struct Range {
   static Range non_negative() { return {0, std::numeric_limits<double>::infinity(), false, true}; }
   static Range closed(double a, double b) { return {a, b, false, false}; }
   static Range half_open(double a, double b) { return {a, b, false, true}; }
+  static Range at_least(double a) {
+    return {a, std::numeric_limits<double>::infinity(), false, true};
+  }
 };
 
 /// Why `path` cannot be an input file (a directory, a device or a socket), or "".
