@@ -135,8 +135,8 @@ public:
   double load_ref() const { return load_ref_; } ///< load when loading began [Pa]
   /// The change of every energy term since loading began (since the test began before it) [J].
   EnergyLedger energy_since_loading() const;
-  double sep_ref() const { return sep_ref_; }         ///< separation when loading began [m]
-  double separation() const;                          ///< platen or grip separation [m]
+  double sep_ref() const { return sep_ref_; } ///< separation when loading began [m]
+  double separation() const;                  ///< platen or grip separation [m]
   std::int64_t load_start_step() const { return load_start_step_; }
   std::int64_t reverse_step() const { return reverse_step_; }
   bool confined() const { return !lateral_.empty(); }
