@@ -1,7 +1,7 @@
 #include "lab/protocol_table.hpp"
 
 #include "io/json_input.hpp"
-#include "lab/protocols/frame_test.hpp"
+#include "lab/protocols/frame_protocol.hpp"
 
 namespace rocklab {
 

@@ -3,7 +3,7 @@
 #include "lab/frame/loading_frame.hpp"
 
 #include "io/json_input.hpp"
-#include "lab/protocols/frame_test.hpp"
+#include "lab/protocols/frame_protocol.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -10,7 +10,7 @@
 // the load collapses below stop.failed_fraction of its peak without a split
 // (docs/protocol-format.md).
 #include "lab/protocols/brazilian.hpp"
-#include "lab/protocols/frame_test.hpp"
+#include "lab/protocols/frame_protocol.hpp"
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"

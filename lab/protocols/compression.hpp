@@ -5,7 +5,7 @@
 #pragma once
 
 #include "lab/frame/curve_analysis.hpp"
-#include "lab/protocols/frame_test.hpp"
+#include "lab/protocols/frame_protocol.hpp"
 
 namespace rocklab {
 

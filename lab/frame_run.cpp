@@ -1,4 +1,4 @@
-#include "lab/run_test.hpp"
+#include "lab/frame_run.hpp"
 
 #include "io/json_input.hpp"
 #include "io/output_dir.hpp"
@@ -7,7 +7,7 @@
 #include "io/specimen.hpp"
 #include "lab/frame_snapshot.hpp"
 #include "lab/protocol_table.hpp"
-#include "lab/protocols/frame_test.hpp"
+#include "lab/protocols/frame_protocol.hpp"
 #include "materials/genesis.hpp"
 #include "viz/svg_plots.hpp"
 #include "viz/svg_png.hpp"

@@ -1,7 +1,7 @@
 // A laboratory test in the loading frame (UCS, triaxial, Brazilian, direct tension, ...): how the
 // frame is set up, what its readings mean, when the test ends, what it reports and how it is
 // plotted. One file per test under lab/protocols/, one row in lab/protocol_table.cpp; the frame
-// (lab/frame/) and the run loop (lab/run_test.cpp) do the rest. Units SI.
+// (lab/frame/) and the run loop (lab/frame_run.cpp) do the rest. Units SI.
 #pragma once
 
 #include "lab/frame/loading_frame.hpp"
@@ -22,7 +22,7 @@ struct PlotLabels {
 
 class FrameTest : public LabProtocol {
 public:
-  /// Runs the protocol file in the frame (lab/run_test.cpp).
+  /// Runs the protocol file in the frame (lab/frame_run.cpp).
   LabSummary run(const nlohmann::json& j, const std::string& file, const LabOptions& o) override;
   void print(const LabSummary& s, const std::string& out_dir) const override;
 

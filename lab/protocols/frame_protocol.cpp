@@ -1,6 +1,6 @@
 // The defaults of a test in the loading frame: unconfined, no Brazilian stop keys, not a disk, and
 // the standard post-peak stop rule.
-#include "lab/protocols/frame_test.hpp"
+#include "lab/protocols/frame_protocol.hpp"
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"
