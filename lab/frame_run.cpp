@@ -198,16 +198,12 @@ bool FrameRun::loop() {
   return true;
 }
 
-// The crack-initiation and crack-damage stresses on the axial curve, where results.json has them;
-// a Brazilian test's tensile strength where it is not the peak (taken before the split released
-// the diametral tension).
-std::vector<PlotMarker> crack_markers(const LoadingFrame& f, const nlohmann::json& r) {
+// The test's own markers, then the crack-initiation and crack-damage stresses on the axial curve
+// where results.json has them.
+std::vector<PlotMarker> crack_markers(const FrameTest& test, const LoadingFrame& f,
+                                      const nlohmann::json& r) {
   std::vector<PlotMarker> m;
-  if (r.contains("split") && r["split"].contains("stress_Pa") &&
-      r["split"]["stress_Pa"] != r["split"]["peak_Pa"])
-    m.push_back({100 * r["peak_axial_strain"].get<double>(),
-                 1e-6 * r["tensile_strength_Pa"].get<double>(),
-                 "tensile strength (before the split)"});
+  test.plot_markers(r, m);
   if (!r.contains("crack_stresses"))
     return m;
   const nlohmann::json& c = r["crack_stresses"];
@@ -275,7 +271,7 @@ PlotDocuments plot_documents(const FrameTest& test, const LoadingFrame& f,
       std::string(test.name()) + " test: " + meta.value("material_name", std::string("specimen"));
   Snapshot final = frame_snapshot(f);
   add_fractures(final, f.cracks().cracks(), ev, INFINITY);
-  return {line_plot_svg(title, labels.x, labels.y, "cracks", series, crack_markers(f, r)),
+  return {line_plot_svg(title, labels.x, labels.y, "cracks", series, crack_markers(test, f, r)),
           crack_map_svg(final, title + ", cracks at the end", labels.map_axis)};
 }
 
@@ -414,24 +410,8 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
                   mpa("crack_initiation_stress_Pa"), ratio("crack_initiation_ratio"),
                   mpa("crack_initiation_stress_volumetric_Pa"), mpa("crack_damage_stress_Pa"),
                   ratio("crack_damage_ratio"));
-    if (json_number(r, "confinement_Pa", 0.0) > 0)
-      std::printf("confinement  %.4g MPa (held between %.4g and %.4g MPa)\n", mpa("confinement_Pa"),
-                  1e-6 * r["confinement_measured_Pa"]["min"].get<double>(),
-                  1e-6 * r["confinement_measured_Pa"]["max"].get<double>());
   }
-  if (r.contains("tensile_strength_Pa") && r["tensile_strength_Pa"].is_number()) {
-    std::printf("tensile strength %.4g MPa (force %.4g N)", mpa("tensile_strength_Pa"),
-                r["peak_force_N"].get<double>());
-    if (r.contains("split") && r["split"]["tension_lost_step"].get<std::int64_t>() >= 0 &&
-        r["split"]["peak_step"] > r["split"]["tension_lost_step"])
-      std::printf(" before the split released the diametral tension; the halves then carried up "
-                  "to %.4g MPa",
-                  1e-6 * r["split"]["peak_Pa"].get<double>());
-    std::printf("\n");
-  } else if (r.contains("tensile_strength_Pa")) {
-    std::printf("tensile strength not measured (no split); 2F/(pi D t) peaked at %.4g MPa\n",
-                1e-6 * r["split"]["peak_Pa"].get<double>());
-  }
+  print_results(r);
   const auto& c = r["cracks"];
   std::printf("cracks       %lld tension, %lld shear (%lld at peak)\n",
               static_cast<long long>(c["tension"].get<std::int64_t>()),

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -214,6 +215,40 @@ public:
   }
   PlotLabels plot_labels() const override {
     return {"platen displacement / D [%]", "2F / (pi D t) [MPa]", false, 2};
+  }
+  // The strength before the split released the diametral tension, and what the halves carried.
+  void print_results(const nlohmann::json& r) const override {
+    if (!r.contains("split")) { // the split check is off: the strength is the peak
+      print_tensile_strength(r);
+      return;
+    }
+    const nlohmann::json& split = r["split"];
+    if (!r["tensile_strength_Pa"].is_number()) {
+      std::printf("tensile strength not measured (no split); 2F/(pi D t) peaked at %.4g MPa\n",
+                  1e-6 * split["peak_Pa"].get<double>());
+      return;
+    }
+    std::string more;
+    if (split["tension_lost_step"].get<std::int64_t>() >= 0 &&
+        split["peak_step"] > split["tension_lost_step"]) {
+      char b[160];
+      std::snprintf(b, sizeof b,
+                    " before the split released the diametral tension; the halves then carried "
+                    "up to %.4g MPa",
+                    1e-6 * split["peak_Pa"].get<double>());
+      more = b;
+    }
+    print_tensile_strength(r, more);
+  }
+  // The tensile strength where it is not the peak (taken before the split).
+  void plot_markers(const nlohmann::json& r, std::vector<PlotMarker>& m) const override {
+    if (!r.contains("split"))
+      return;
+    const nlohmann::json& split = r["split"];
+    if (split.contains("stress_Pa") && split["stress_Pa"] != split["peak_Pa"])
+      m.push_back({100 * r["peak_axial_strain"].get<double>(),
+                   1e-6 * r["tensile_strength_Pa"].get<double>(),
+                   "tensile strength (before the split)"});
   }
   void save(nlohmann::json& state) const override {
     nlohmann::json t = nlohmann::json::array();

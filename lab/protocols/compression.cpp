@@ -1,7 +1,10 @@
 #include "lab/protocols/compression.hpp"
 
+#include "io/results.hpp"
 #include "lab/frame/curve_analysis.hpp"
 #include "lab/frame/elastic_fit.hpp"
+
+#include <cstdio>
 
 namespace rocklab {
 
@@ -79,6 +82,14 @@ void CompressionTest::results(const LoadingFrame& f, nlohmann::json& r) const {
 
 PlotLabels CompressionTest::plot_labels() const {
   return {"strain [%] (compression positive)", "axial stress [MPa]", true, 1};
+}
+
+void CompressionTest::print_results(const nlohmann::json& r) const {
+  if (json_number(r, "confinement_Pa", 0.0) > 0)
+    std::printf("confinement  %.4g MPa (held between %.4g and %.4g MPa)\n",
+                1e-6 * json_number(r, "confinement_Pa", 0.0),
+                1e-6 * r["confinement_measured_Pa"]["min"].get<double>(),
+                1e-6 * r["confinement_measured_Pa"]["max"].get<double>());
 }
 
 } // namespace rocklab

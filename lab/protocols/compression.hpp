@@ -15,6 +15,7 @@ public:
   void stresses(const LoadingFrame& f, LabSample& s) const override;
   void results(const LoadingFrame& f, nlohmann::json& r) const override;
   PlotLabels plot_labels() const override;
+  void print_results(const nlohmann::json& r) const override;
 
   /// The loading branch up to the peak with the crack count at each sample.
   static CurveInput curve(const LoadingFrame& f);

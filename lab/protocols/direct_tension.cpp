@@ -34,6 +34,10 @@ public:
   PlotLabels plot_labels() const override {
     return {"strain [%] (compression positive)", "tensile stress [MPa]", false, 1};
   }
+  void print_results(const nlohmann::json& r) const override {
+    if (r["tensile_strength_Pa"].is_number())
+      print_tensile_strength(r);
+  }
 };
 
 } // namespace

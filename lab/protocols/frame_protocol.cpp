@@ -1,9 +1,11 @@
 // The defaults of a test in the loading frame: unconfined, no Brazilian stop keys, not a disk, and
-// the standard post-peak stop rule.
+// the standard post-peak stop rule; the printout's tensile-strength line.
 #include "lab/protocols/frame_protocol.hpp"
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"
+
+#include <cstdio>
 
 namespace rocklab {
 
@@ -34,6 +36,12 @@ std::string FrameTest::stop_after_drop(LoadingFrame& f) {
 
 std::string load_fell_reason(const Protocol& p) {
   return "the load fell below " + format_double(p.post_peak_fraction) + " of its peak";
+}
+
+void print_tensile_strength(const nlohmann::json& r, const std::string& more) {
+  std::printf("tensile strength %.4g MPa (force %.4g N)%s\n",
+              1e-6 * json_number(r, "tensile_strength_Pa", 0.0),
+              json_number(r, "peak_force_N", 0.0), more.c_str());
 }
 
 } // namespace rocklab

@@ -6,8 +6,10 @@
 
 #include "lab/frame/loading_frame.hpp"
 #include "lab/lab_protocol.hpp"
+#include "viz/svg_plots.hpp"
 
 #include <string>
+#include <vector>
 
 namespace rocklab {
 
@@ -45,6 +47,10 @@ public:
   /// The test's own results (the frame writes the common ones).
   virtual void results(const LoadingFrame& f, nlohmann::json& r) const = 0;
   virtual PlotLabels plot_labels() const = 0;
+  /// The test's own lines of the printout, after the common ones on the peak (default: none).
+  virtual void print_results(const nlohmann::json& /*r*/) const {}
+  /// The test's own markers on the stress-strain plot, before the crack stresses' (default: none).
+  virtual void plot_markers(const nlohmann::json& /*r*/, std::vector<PlotMarker>& /*m*/) const {}
   /// The test's own state, for checkpoints.
   virtual void save(nlohmann::json& /*state*/) const {}
   virtual void load(const nlohmann::json& /*state*/, const std::string& /*file*/) {}
@@ -52,5 +58,7 @@ public:
 
 /// The stop reason of the standard post-peak rule.
 std::string load_fell_reason(const Protocol& p);
+/// The printout's tensile-strength line: "tensile strength X MPa (force F N)", then `more`.
+void print_tensile_strength(const nlohmann::json& r, const std::string& more = "");
 
 } // namespace rocklab

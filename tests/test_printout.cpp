@@ -1,0 +1,72 @@
+// Each test in the frame supplies its own printout lines and plot markers (issue 41): the generic
+// printout and plot know no test by name. Results are synthetic JSON, as results.json has them.
+#include "lab/protocol_table.hpp"
+#include "lab/protocols/frame_protocol.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace rocklab;
+using nlohmann::json;
+
+namespace {
+
+std::string printed(const FrameTest& t, const json& r) {
+  testing::internal::CaptureStdout();
+  t.print_results(r);
+  return testing::internal::GetCapturedStdout();
+}
+
+} // namespace
+
+TEST(Printout, ABrazilianTestPrintsAndMarksItsStrengthBeforeTheSplit) {
+  const auto t = make_frame_test("brazilian");
+  ASSERT_TRUE(t);
+  json r = {{"tensile_strength_Pa", 8.5e6},
+            {"peak_force_N", 1234.0},
+            {"peak_axial_strain", 0.002},
+            {"split",
+             {{"stress_Pa", 8.5e6},
+              {"peak_Pa", 9.75e6},
+              {"tension_lost_step", 100},
+              {"peak_step", 200}}}};
+  EXPECT_EQ(printed(*t, r), "tensile strength 8.5 MPa (force 1234 N) before the split released the "
+                            "diametral tension; the halves then carried up to 9.75 MPa\n");
+  std::vector<PlotMarker> m;
+  t->plot_markers(r, m);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_DOUBLE_EQ(m[0].x, 0.2);
+  EXPECT_DOUBLE_EQ(m[0].y, 8.5);
+  EXPECT_EQ(m[0].label, "tensile strength (before the split)");
+  // The strength at the peak: no clause and no marker.
+  r["split"]["stress_Pa"] = 9.75e6;
+  r["split"]["tension_lost_step"] = -1;
+  r["tensile_strength_Pa"] = 9.75e6;
+  EXPECT_EQ(printed(*t, r), "tensile strength 9.75 MPa (force 1234 N)\n");
+  m.clear();
+  t->plot_markers(r, m);
+  EXPECT_TRUE(m.empty());
+  // No split: no strength.
+  r["tensile_strength_Pa"] = nullptr;
+  EXPECT_EQ(printed(*t, r),
+            "tensile strength not measured (no split); 2F/(pi D t) peaked at 9.75 MPa\n");
+  // The split check off: the peak, and no split record.
+  r.erase("split");
+  r["tensile_strength_Pa"] = 7e6;
+  EXPECT_EQ(printed(*t, r), "tensile strength 7 MPa (force 1234 N)\n");
+}
+
+TEST(Printout, TriaxialPrintsItsConfinementAndTheOthersTheirOwnLinesOnly) {
+  const json confined = {{"confinement_Pa", 5e6},
+                         {"confinement_measured_Pa", {{"min", 4.9e6}, {"max", 5.1e6}}}};
+  EXPECT_EQ(printed(*make_frame_test("triaxial"), confined),
+            "confinement  5 MPa (held between 4.9 and 5.1 MPa)\n");
+  EXPECT_EQ(printed(*make_frame_test("ucs"), {{"confinement_Pa", 0.0}}), "");
+  EXPECT_EQ(printed(*make_frame_test("direct_tension"),
+                    {{"tensile_strength_Pa", 3e6}, {"peak_force_N", 50.0}}),
+            "tensile strength 3 MPa (force 50 N)\n");
+  for (const char* name : {"ucs", "triaxial", "direct_tension"}) {
+    std::vector<PlotMarker> m;
+    make_frame_test(name)->plot_markers(confined, m);
+    EXPECT_TRUE(m.empty()) << name;
+  }
+}
