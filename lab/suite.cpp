@@ -4,6 +4,8 @@
 #include "io/output_dir.hpp"
 #include "io/results.hpp"
 #include "lab/protocol.hpp"
+#include "lab/protocol_table.hpp"
+#include "lab/protocols/frame_protocol.hpp"
 #include "lab/suite_jobs.hpp"
 #include "materials/material_card.hpp"
 
@@ -267,9 +269,7 @@ std::vector<Job> SuiteRun::run_tests(const std::map<std::string, std::string>& s
 // 3. The summary of the tests' results.
 struct SuiteSummary {
   nlohmann::json tests = nlohmann::json::array();
-  std::vector<double> s3, s1; ///< confinement and peak stress of UCS and triaxial tests [Pa]
-  double ucs = std::nan(""), e = std::nan(""), nu = std::nan(""), bts = std::nan(""),
-         dt = std::nan(""), ci = std::nan(""), ci_count = std::nan("");
+  SuiteValues values; ///< what each test's results gave (the tests' own add_to_suite)
   nlohmann::json warnings = nlohmann::json::array(); ///< every test's, as "NAME: what"
   bool failed = false;
   std::string csv = "name,test,status,confinement_Pa,youngs_modulus_Pa,poisson_ratio,"
@@ -315,24 +315,8 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
   row["grains"] = r["provenance"]["grains"];
   row["steps"] = r["provenance"]["steps"];
   const std::string type = r.value("test", "");
-  if (type == "ucs" || type == "triaxial") {
-    s3.push_back(type == "ucs" ? 0.0 : conf);
-    s1.push_back(num(r, "peak_stress_Pa"));
-  }
-  if (type == "ucs" && std::isnan(ucs)) {
-    ucs = num(r, "peak_stress_Pa");
-    e = num(r, "youngs_modulus_Pa");
-    nu = num(r, "poisson_ratio");
-    // The laboratory's crack initiation is read from the stress-strain curves (Nicksiar & Martin
-    // 2013: 376 tests, CI/peak 0.42-0.47), so the summary's ratio is the strain-based one; the
-    // crack-count onset, which no laboratory measures, is beside it.
-    ci = num(r, "crack_initiation_stress_volumetric_Pa");
-    ci_count = num(r, "crack_initiation_stress_Pa");
-  }
-  if (type == "brazilian" && std::isnan(bts))
-    bts = num(r, "tensile_strength_Pa");
-  if (type == "direct_tension" && std::isnan(dt))
-    dt = num(r, "tensile_strength_Pa");
+  if (const std::unique_ptr<FrameTest> test = make_frame_test(type))
+    test->add_to_suite(r, values);
   auto f = [&](const char* key) {
     const double v = num(r, key);
     return std::isfinite(v) ? format_double(v) : std::string();
@@ -346,18 +330,20 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
 }
 
 nlohmann::json SuiteSummary::properties() const {
-  const Envelope env = fit_envelope(s3, s1);
+  const Envelope env = fit_envelope(values.s3, values.s1);
+  auto v = [&](const char* name) { return values.get(name); };
   nlohmann::json props{
-      {"youngs_modulus_Pa", or_null(e)},
-      {"poisson_ratio", or_null(nu)},
-      {"ucs_Pa", or_null(ucs)},
-      {"bts_Pa", or_null(bts)},
-      {"direct_tension_Pa", or_null(dt)},
-      {"ucs_over_bts", or_null(ucs / bts)},
-      {"crack_initiation_stress_Pa", or_null(ci)},
-      {"crack_initiation_over_ucs", or_null(ci / ucs)},
-      {"crack_initiation_count_over_ucs", or_null(ci_count / ucs)},
-      {"direct_tension_over_bts", or_null(dt / bts)},
+      {"youngs_modulus_Pa", or_null(v("youngs_modulus_Pa"))},
+      {"poisson_ratio", or_null(v("poisson_ratio"))},
+      {"ucs_Pa", or_null(v("ucs_Pa"))},
+      {"bts_Pa", or_null(v("bts_Pa"))},
+      {"direct_tension_Pa", or_null(v("direct_tension_Pa"))},
+      {"ucs_over_bts", or_null(v("ucs_Pa") / v("bts_Pa"))},
+      {"crack_initiation_stress_Pa", or_null(v("crack_initiation_stress_Pa"))},
+      {"crack_initiation_over_ucs", or_null(v("crack_initiation_stress_Pa") / v("ucs_Pa"))},
+      {"crack_initiation_count_over_ucs",
+       or_null(v("crack_initiation_count_stress_Pa") / v("ucs_Pa"))},
+      {"direct_tension_over_bts", or_null(v("direct_tension_Pa") / v("bts_Pa"))},
       {"friction_angle_deg",
        env.has_mc ? or_null(env.friction_angle_deg) : nlohmann::json(nullptr)},
       {"cohesion_Pa", env.has_mc ? or_null(env.cohesion) : nlohmann::json(nullptr)},

@@ -4,6 +4,8 @@
 #include "io/json_input.hpp"
 #include "io/results.hpp"
 #include "lab/protocol.hpp"
+#include "lab/protocol_table.hpp"
+#include "lab/protocols/frame_protocol.hpp"
 #include "materials/material_card.hpp"
 
 #include <cmath>
@@ -14,19 +16,18 @@ namespace fs = std::filesystem;
 
 namespace rocklab::calibration {
 
+// The targets a calibration can aim at: the suite properties the frame tests declare, in the
+// protocol table's order (adding a property = the test that measures it).
 const std::vector<TargetNeed>& target_needs() {
-  static const std::vector<TargetNeed> needs{
-      {kYoungs, "ucs", 1, nullptr},
-      {kPoisson, "ucs", 1, nullptr},
-      {kUcs, "ucs", 1, nullptr},
-      {"crack_initiation_over_ucs", "ucs", 1, nullptr},
-      {"bts_Pa", "brazilian", 1, nullptr},
-      {"direct_tension_Pa", "direct_tension", 1, nullptr},
-      {"ucs_over_bts", "ucs", 1, "brazilian"},
-      {"direct_tension_over_bts", "direct_tension", 1, "brazilian"},
-      {"friction_angle_deg", "triaxial", 1, "ucs"},
-      {"cohesion_Pa", "triaxial", 1, "ucs"},
-      {"hoek_brown_mi", "triaxial", 2, "ucs"}};
+  static const std::vector<TargetNeed> needs = [] {
+    std::vector<TargetNeed> n;
+    for (const std::string& name : frame_test_names()) {
+      const std::unique_ptr<FrameTest> test = make_frame_test(name);
+      for (const SuiteProperty& p : test->suite_properties()) // name(): a literal, it outlives test
+        n.push_back({p.name, test->name(), p.count, p.other});
+    }
+    return n;
+  }();
   return needs;
 }
 

@@ -240,6 +240,11 @@ public:
     }
     print_tensile_strength(r, more);
   }
+  std::vector<SuiteProperty> suite_properties() const override { return {{"bts_Pa"}}; }
+  void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override {
+    if (!v.has("bts_Pa"))
+      v.values["bts_Pa"] = json_number(r, "tensile_strength_Pa", std::nan(""));
+  }
   // The tensile strength where it is not the peak (taken before the split).
   void plot_markers(const nlohmann::json& r, std::vector<PlotMarker>& m) const override {
     if (!r.contains("split"))

@@ -92,4 +92,9 @@ void CompressionTest::print_results(const nlohmann::json& r) const {
                 1e-6 * r["confinement_measured_Pa"]["max"].get<double>());
 }
 
+void CompressionTest::add_to_suite(const nlohmann::json& r, SuiteValues& v) const {
+  v.s3.push_back(setup().confined ? json_number(r, "confinement_Pa", std::nan("")) : 0.0);
+  v.s1.push_back(json_number(r, "peak_stress_Pa", std::nan("")));
+}
+
 } // namespace rocklab

@@ -16,6 +16,8 @@ public:
   void results(const LoadingFrame& f, nlohmann::json& r) const override;
   PlotLabels plot_labels() const override;
   void print_results(const nlohmann::json& r) const override;
+  /// A point (confinement, peak stress) of the strength envelope.
+  void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override;
 
   /// The loading branch up to the peak with the crack count at each sample.
   static CurveInput curve(const LoadingFrame& f);

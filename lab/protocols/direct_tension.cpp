@@ -3,6 +3,7 @@
 // (docs/protocol-format.md).
 #include "lab/protocols/frame_protocol.hpp"
 
+#include "io/results.hpp"
 #include "lab/frame/elastic_fit.hpp"
 
 namespace rocklab {
@@ -33,6 +34,13 @@ public:
   }
   PlotLabels plot_labels() const override {
     return {"strain [%] (compression positive)", "tensile stress [MPa]", false, 1};
+  }
+  std::vector<SuiteProperty> suite_properties() const override {
+    return {{"direct_tension_Pa"}, {"direct_tension_over_bts", 1, "brazilian"}};
+  }
+  void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override {
+    if (!v.has("direct_tension_Pa"))
+      v.values["direct_tension_Pa"] = json_number(r, "tensile_strength_Pa", std::nan(""));
   }
   void print_results(const nlohmann::json& r) const override {
     if (r["tensile_strength_Pa"].is_number())

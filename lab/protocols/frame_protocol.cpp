@@ -44,4 +44,9 @@ void print_tensile_strength(const nlohmann::json& r, const std::string& more) {
               json_number(r, "peak_force_N", 0.0), more.c_str());
 }
 
+double SuiteValues::get(const std::string& name) const {
+  const auto it = values.find(name);
+  return it == values.end() ? std::nan("") : it->second;
+}
+
 } // namespace rocklab

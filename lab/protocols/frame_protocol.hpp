@@ -8,6 +8,8 @@
 #include "lab/lab_protocol.hpp"
 #include "viz/svg_plots.hpp"
 
+#include <cmath>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -20,6 +22,25 @@ struct PlotLabels {
   std::string x, y;     ///< axis labels
   bool lateral = false; ///< also plot the axial stress against the lateral strain
   int map_axis = 1;     ///< the crack map's section normal (0 x, 1 y, 2 z)
+};
+
+/// A property of the material that suites and calibrations derive from a test's results: its name
+/// in summary.json and as a calibration target, how many tests of that kind it needs, and a second
+/// kind of test it needs as well (nullptr: none).
+struct SuiteProperty {
+  const char* name;
+  int count = 1;
+  const char* other = nullptr;
+};
+
+/// What a suite gathers from its tests' results: values by name (set by the first test of the
+/// kind that measures them) and the strength envelope's points.
+struct SuiteValues {
+  std::map<std::string, double> values;
+  std::vector<double> s3, s1; ///< confinement and peak stress of the compression tests [Pa]
+  /// The value, NaN when no test gave it.
+  double get(const std::string& name) const;
+  bool has(const std::string& name) const { return !std::isnan(get(name)); }
 };
 
 class FrameTest : public LabProtocol {
@@ -51,6 +72,10 @@ public:
   virtual void print_results(const nlohmann::json& /*r*/) const {}
   /// The test's own markers on the stress-strain plot, before the crack stresses' (default: none).
   virtual void plot_markers(const nlohmann::json& /*r*/, std::vector<PlotMarker>& /*m*/) const {}
+  /// The material properties this test gives suites and calibrations (default: none).
+  virtual std::vector<SuiteProperty> suite_properties() const { return {}; }
+  /// Add this test's results.json to a suite's values (default: nothing).
+  virtual void add_to_suite(const nlohmann::json& /*r*/, SuiteValues& /*v*/) const {}
   /// The test's own state, for checkpoints.
   virtual void save(nlohmann::json& /*state*/) const {}
   virtual void load(const nlohmann::json& /*state*/, const std::string& /*file*/) {}

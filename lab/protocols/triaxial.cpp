@@ -18,6 +18,11 @@ public:
     s.first_phase = kConfine;
     return s;
   }
+  // The strength envelope through the UCS and the triaxial peaks (Hoek-Brown needs two).
+  std::vector<SuiteProperty> suite_properties() const override {
+    return {
+        {"friction_angle_deg", 1, "ucs"}, {"cohesion_Pa", 1, "ucs"}, {"hoek_brown_mi", 2, "ucs"}};
+  }
   void check_loading(JsonObject& loading, const Protocol& p) const override {
     if (!(p.confinement > 0))
       loading.fail("confinement", "a triaxial test needs a confining stress > 0 Pa");

@@ -3,6 +3,8 @@
 // peak (docs/protocol-format.md).
 #include "lab/protocols/compression.hpp"
 
+#include "io/results.hpp"
+
 namespace rocklab {
 
 namespace {
@@ -11,6 +13,28 @@ class UcsTest final : public CompressionTest {
 public:
   const char* name() const override { return "ucs"; }
   FrameSetup setup() const override { return {}; }
+  std::vector<SuiteProperty> suite_properties() const override {
+    return {{"youngs_modulus_Pa"},
+            {"poisson_ratio"},
+            {"ucs_Pa"},
+            {"crack_initiation_over_ucs"},
+            {"ucs_over_bts", 1, "brazilian"}};
+  }
+  // The first UCS test gives E, nu, the UCS and the crack-initiation stresses. The laboratory's
+  // crack initiation is read from the stress-strain curves (Nicksiar & Martin 2013: 376 tests,
+  // CI/peak 0.42-0.47), so the summary's ratio is the strain-based one; the crack-count onset,
+  // which no laboratory measures, is beside it.
+  void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override {
+    CompressionTest::add_to_suite(r, v);
+    if (v.has("ucs_Pa"))
+      return;
+    auto num = [&](const char* key) { return json_number(r, key, std::nan("")); };
+    v.values["ucs_Pa"] = num("peak_stress_Pa");
+    v.values["youngs_modulus_Pa"] = num("youngs_modulus_Pa");
+    v.values["poisson_ratio"] = num("poisson_ratio");
+    v.values["crack_initiation_stress_Pa"] = num("crack_initiation_stress_volumetric_Pa");
+    v.values["crack_initiation_count_stress_Pa"] = num("crack_initiation_stress_Pa");
+  }
 };
 
 } // namespace
