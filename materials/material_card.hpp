@@ -1,5 +1,10 @@
 // Material card: what a specimen is made of and how it is made (docs/material-format.md).
-// All quantities SI.
+// All quantities SI. A model section's keys are read by the contact model's own reader
+// (read_model_section in the .cpp); the card adds per-contact distributions and types.
+// Recipe, a new bonding choice for cards (a bonded contact model already in the registry):
+// its section in read_bonding (material_card.cpp: read_model_section<Model> with the model's key
+// prefix and the card's own keys), a Bonding value, its branch in genesis/finalization.cpp (the
+// per-contact draws), its count in GenesisReport, and its paragraph in docs/material-format.md.
 #pragma once
 
 #include "contact/registry.hpp"
