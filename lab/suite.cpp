@@ -170,10 +170,6 @@ double num(const nlohmann::json& r, const char* key) {
   return json_number(r, key, std::nan(""));
 }
 
-nlohmann::json or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
 } // namespace
 
 namespace {
@@ -301,10 +297,10 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
   row["status"] = "ok";
   row["results"] = "tests/" + t.name + "/results.json";
   const double conf = num(r, "confinement_Pa");
-  row["confinement_Pa"] = or_null(conf);
+  row["confinement_Pa"] = number_or_null(conf);
   for (const char* key : {"youngs_modulus_Pa", "poisson_ratio", "peak_stress_Pa",
                           "peak_deviator_Pa", "tensile_strength_Pa"})
-    row[key] = or_null(num(r, key));
+    row[key] = number_or_null(num(r, key));
   row["cracks"] = r["cracks"];
   if (r.contains("warnings")) {
     row["warnings"] = r["warnings"];
@@ -329,28 +325,12 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
   tests.push_back(row);
 }
 
+// Every frame test adds its part, whichever tests this suite ran (a property no test measured is
+// null).
 nlohmann::json SuiteSummary::properties() const {
-  const Envelope env = fit_envelope(values.s3, values.s1);
-  auto v = [&](const char* name) { return values.get(name); };
-  nlohmann::json props{
-      {"youngs_modulus_Pa", or_null(v("youngs_modulus_Pa"))},
-      {"poisson_ratio", or_null(v("poisson_ratio"))},
-      {"ucs_Pa", or_null(v("ucs_Pa"))},
-      {"bts_Pa", or_null(v("bts_Pa"))},
-      {"direct_tension_Pa", or_null(v("direct_tension_Pa"))},
-      {"ucs_over_bts", or_null(v("ucs_Pa") / v("bts_Pa"))},
-      {"crack_initiation_stress_Pa", or_null(v("crack_initiation_stress_Pa"))},
-      {"crack_initiation_over_ucs", or_null(v("crack_initiation_stress_Pa") / v("ucs_Pa"))},
-      {"crack_initiation_count_over_ucs",
-       or_null(v("crack_initiation_count_stress_Pa") / v("ucs_Pa"))},
-      {"direct_tension_over_bts", or_null(v("direct_tension_Pa") / v("bts_Pa"))},
-      {"friction_angle_deg",
-       env.has_mc ? or_null(env.friction_angle_deg) : nlohmann::json(nullptr)},
-      {"cohesion_Pa", env.has_mc ? or_null(env.cohesion) : nlohmann::json(nullptr)},
-      {"mohr_coulomb_r2", env.has_mc ? or_null(env.r2_mc) : nlohmann::json(nullptr)},
-      {"hoek_brown_mi", env.has_hb ? or_null(env.hb_mi) : nlohmann::json(nullptr)},
-      {"hoek_brown_sigma_c_Pa", env.has_hb ? or_null(env.hb_sigma_c) : nlohmann::json(nullptr)},
-      {"envelope_points", env.points}};
+  nlohmann::json props = nlohmann::json::object();
+  for (const std::string& name : frame_test_names())
+    make_frame_test(name)->suite_results(values, props);
   return props;
 }
 

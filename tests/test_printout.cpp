@@ -1,5 +1,7 @@
 // Each test in the frame supplies its own printout lines and plot markers (issue 41): the generic
-// printout and plot know no test by name. Results are synthetic JSON, as results.json has them.
+// printout and plot know no test by name; the suite properties they declare are the summary keys
+// and calibration targets. Results are synthetic JSON, as results.json has them.
+#include "lab/calibration/calibration_file.hpp"
 #include "lab/protocol_table.hpp"
 #include "lab/protocols/frame_protocol.hpp"
 
@@ -69,4 +71,26 @@ TEST(Printout, TriaxialPrintsItsConfinementAndTheOthersTheirOwnLinesOnly) {
     make_frame_test(name)->plot_markers(confined, m);
     EXPECT_TRUE(m.empty()) << name;
   }
+}
+
+TEST(Printout, EveryDeclaredSuitePropertyIsASummaryKeyAndACalibrationTarget) {
+  // A property a test declares reaches summary.json (null until measured) and the calibration's
+  // targets with that test as the one that measures it: no second name table to edit.
+  int declared = 0;
+  for (const std::string& name : frame_test_names()) {
+    const auto t = make_frame_test(name);
+    json props = json::object();
+    t->suite_results(SuiteValues{}, props);
+    for (const SuiteProperty& p : t->suite_properties()) {
+      ++declared;
+      EXPECT_TRUE(props.contains(p.name)) << name << " " << p.name;
+      EXPECT_TRUE(props[p.name].is_null()) << p.name;
+      bool target = false;
+      for (const calibration::TargetNeed& n : calibration::target_needs())
+        target = target || (std::string(n.property) == p.name && n.test == name);
+      EXPECT_TRUE(target) << p.name;
+    }
+  }
+  EXPECT_EQ(static_cast<std::size_t>(declared), calibration::target_needs().size());
+  EXPECT_EQ(std::string(calibration::target_needs().front().property), "youngs_modulus_Pa");
 }

@@ -42,6 +42,10 @@ public:
     if (!v.has("direct_tension_Pa"))
       v.values["direct_tension_Pa"] = json_number(r, "tensile_strength_Pa", std::nan(""));
   }
+  void suite_results(const SuiteValues& v, nlohmann::json& props) const override {
+    props["direct_tension_Pa"] = number_or_null(v.get("direct_tension_Pa"));
+    props["direct_tension_over_bts"] = number_or_null(v.get("direct_tension_Pa") / v.get("bts_Pa"));
+  }
   void print_results(const nlohmann::json& r) const override {
     if (r["tensile_strength_Pa"].is_number())
       print_tensile_strength(r);

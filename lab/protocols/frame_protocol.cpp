@@ -49,4 +49,13 @@ double SuiteValues::get(const std::string& name) const {
   return it == values.end() ? std::nan("") : it->second;
 }
 
+void FrameTest::suite_results(const SuiteValues& v, nlohmann::json& props) const {
+  for (const SuiteProperty& p : suite_properties())
+    props[p.name] = number_or_null(v.get(p.name));
+}
+
+nlohmann::json number_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
 } // namespace rocklab

@@ -76,6 +76,9 @@ public:
   virtual std::vector<SuiteProperty> suite_properties() const { return {}; }
   /// Add this test's results.json to a suite's values (default: nothing).
   virtual void add_to_suite(const nlohmann::json& /*r*/, SuiteValues& /*v*/) const {}
+  /// This test's part of a suite's material properties (summary.json), from what every test
+  /// gathered: by default each declared property's value (null when none was measured).
+  virtual void suite_results(const SuiteValues& v, nlohmann::json& props) const;
   /// The test's own state, for checkpoints.
   virtual void save(nlohmann::json& /*state*/) const {}
   virtual void load(const nlohmann::json& /*state*/, const std::string& /*file*/) {}
@@ -83,6 +86,9 @@ public:
 
 /// The stop reason of the standard post-peak rule.
 std::string load_fell_reason(const Protocol& p);
+/// A finite value as a JSON number, anything else as null (results and summaries).
+nlohmann::json number_or_null(double v);
+
 /// The printout's tensile-strength line: "tensile strength X MPa (force F N)", then `more`.
 void print_tensile_strength(const nlohmann::json& r, const std::string& more = "");
 

@@ -4,6 +4,7 @@
 #include "lab/protocols/compression.hpp"
 
 #include "io/json_input.hpp"
+#include "lab/suite.hpp"
 
 namespace rocklab {
 
@@ -22,6 +23,17 @@ public:
   std::vector<SuiteProperty> suite_properties() const override {
     return {
         {"friction_angle_deg", 1, "ucs"}, {"cohesion_Pa", 1, "ucs"}, {"hoek_brown_mi", 2, "ucs"}};
+  }
+  // Mohr-Coulomb from two confinements on, Hoek-Brown from three (the UCS counts as one).
+  void suite_results(const SuiteValues& v, nlohmann::json& props) const override {
+    const Envelope env = fit_envelope(v.s3, v.s1);
+    const nlohmann::json none = nullptr;
+    props["friction_angle_deg"] = env.has_mc ? number_or_null(env.friction_angle_deg) : none;
+    props["cohesion_Pa"] = env.has_mc ? number_or_null(env.cohesion) : none;
+    props["mohr_coulomb_r2"] = env.has_mc ? number_or_null(env.r2_mc) : none;
+    props["hoek_brown_mi"] = env.has_hb ? number_or_null(env.hb_mi) : none;
+    props["hoek_brown_sigma_c_Pa"] = env.has_hb ? number_or_null(env.hb_sigma_c) : none;
+    props["envelope_points"] = env.points;
   }
   void check_loading(JsonObject& loading, const Protocol& p) const override {
     if (!(p.confinement > 0))
