@@ -82,6 +82,29 @@ TEST(Robustness, AWriteThatFailsIsExitFourAndLeavesNothingHalfWritten) {
   EXPECT_TRUE(left_behind(dir, "out").empty()) << msg;
 }
 
+// An output folder named by a file that exists is a bad command line (status 2), not an internal
+// error (status 1: found by the fuzz run of issue 41), for every command that writes a folder.
+TEST(Robustness, AnOutputFolderThatIsAFileIsABadCommandLine) {
+  const fs::path dir = scratch("out-is-a-file");
+  fs::create_directories(dir);
+  const fs::path file = dir / "taken";
+  std::ofstream(file) << "not a folder\n";
+  const fs::path protocol = dir / "ucs.json";
+  std::ofstream(protocol) << R"({"test": "ucs", "specimen": {"material": ")" + test::source_dir() +
+                                 R"(/tests/data/lab_2d_fj.json"}})";
+  const fs::path suite = dir / "suite.json";
+  std::ofstream(suite)
+      << R"({"name": "s", "material": ")" + test::source_dir() +
+             R"(/tests/data/lab_2d_fj.json", "tests": [{"name": "u", "test": "ucs"}]})";
+  for (const std::string cmd : {" test " + protocol.string(), " suite " + suite.string()}) {
+    std::string msg;
+    EXPECT_EQ(test::run_command(test::binary() + cmd + " -o " + file.string() + " -q", &msg), 2)
+        << msg;
+    EXPECT_NE(msg.find("rocklab: input error: " + file.string()), std::string::npos) << msg;
+    EXPECT_EQ(test::read_file(file), "not a folder\n");
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // The mutation fuzz: shipped scenes, material cards, protocols and calibration files, mutated
 // (tests/mutate.hpp) and run through the command line. Every outcome must be exit 0 (a valid file),

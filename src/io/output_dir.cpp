@@ -1,5 +1,7 @@
 #include "io/output_dir.hpp"
 
+#include "io/input_error.hpp"
+
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -15,7 +17,8 @@ OutputDir::OutputDir(const std::string& path) : dir_(path) {
   std::error_code ec;
   if (fs::exists(dir_, ec)) {
     if (!fs::is_directory(dir_, ec))
-      throw std::runtime_error(path + ": output path exists and is not a directory");
+      throw InputError(path + ": the output path (-o) exists and is not a directory; give a "
+                              "folder, new or existing");
   } else {
     fs::create_directories(dir_, ec);
     if (ec)
