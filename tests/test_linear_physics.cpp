@@ -252,3 +252,35 @@ TEST(LinearPhysics, SlipChangeEventsAreRaised) {
     }
   EXPECT_GE(slips, 1);
 }
+
+// A ball added to a model that has already cycled (issue 41: its adjacency and thread ranges were
+// stale, a crash about one run in five) takes part from the next cycle: it falls onto the floor
+// and comes to the same rest as a ball present from the start.
+TEST(LinearPhysics, ABallAddedAfterTheModelCycledTakesPart) {
+  auto run = [](bool late) {
+    Model m;
+    m.settings.dim = 3;
+    m.settings.timestep = 1e-5;
+    m.settings.gravity = Vec3(0, 0, -9.81);
+    m.walls.push_back(test::plane_wall(3, Vec3::Zero(), Vec3::UnitZ(), 1.0));
+    LinearProps p;
+    p.kn = 1e5;
+    p.ks = 1e5;
+    p.fric = 0.5;
+    m.rules.push_back(test::linear_rule(true, p));
+    const int g = m.group_index("g");
+    for (int i = 0; i < 40; ++i) // a row of resting balls, so that the model has contacts
+      m.balls.add(3, i + 1, Vec3(0.025 * i, 0, 0.01), 0.01, 2650, g);
+    const Vec3 x(0.3, 0.2, 0.05);
+    std::size_t b = late ? 0 : m.balls.add(3, 99, x, 0.01, 2650, g);
+    m.cycle(200);
+    if (late)
+      b = m.balls.add(3, 99, x, 0.01, 2650, g);
+    m.cycle(late ? 30'000 : 29'800);
+    return m.balls.pos[b];
+  };
+  const Vec3 early = run(false), late = run(true);
+  EXPECT_NEAR(early.z(), 0.01, 2e-4); // resting on the floor under its own weight
+  EXPECT_NEAR(late.z(), 0.01, 2e-4);
+  EXPECT_NEAR(late.x(), 0.3, 1e-9);
+}

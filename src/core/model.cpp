@@ -58,6 +58,12 @@ void Model::cycle(std::int64_t count) {
     initialize();
   follow_thread_lease(); // a parent running several processes may lend or take back cores
   ensure_thread_buffers();
+  if (adj_start_.size() != balls.size() + 1) { // balls added since the last detection
+    detect();                                  // their contacts, adjacency and thread ranges
+    for (std::size_t i = 0; i < balls.size(); ++i)
+      max_speed_ =
+          std::max(max_speed_, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
+  }
   if (mass_scale_.size() != balls.size() && !mass_scale_.empty()) { // balls added or removed
     mass_scale_.clear();
     inertia_scale_.clear();
