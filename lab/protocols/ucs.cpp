@@ -36,10 +36,8 @@ public:
     v.values["crack_initiation_count_stress_Pa"] = num("crack_initiation_stress_Pa");
   }
   void suite_results(const SuiteValues& v, nlohmann::json& props) const override {
+    CompressionTest::suite_results(v, props); // E, nu and the UCS as gathered; ratios below
     const double ucs = v.get("ucs_Pa"), ci = v.get("crack_initiation_stress_Pa");
-    props["youngs_modulus_Pa"] = number_or_null(v.get("youngs_modulus_Pa"));
-    props["poisson_ratio"] = number_or_null(v.get("poisson_ratio"));
-    props["ucs_Pa"] = number_or_null(ucs);
     props["ucs_over_bts"] = number_or_null(ucs / v.get("bts_Pa"));
     props["crack_initiation_stress_Pa"] = number_or_null(ci);
     props["crack_initiation_over_ucs"] = number_or_null(ci / ucs);

@@ -47,7 +47,7 @@ StiffnessPair read_stiffness_pair(JsonObject& p, const std::string& prefix, cons
     s.emod = p.number(emod, Range::positive(), std::nullopt, "Pa");
     s.kratio = p.number(kratio, Range::non_negative(), 0.0);
     if (s.kratio > 0 && s.kratio < 1e-3)
-      p.fail(kratio, "value " + std::to_string(s.kratio) +
+      p.fail(kratio, "value " + p.raw(kratio).dump() +
                          " is out of range: 0 (no shear stiffness) or [0.001, +inf)");
   } else {
     s.kn = p.number(kn, Range::non_negative(), kn_required ? std::nullopt : std::optional(0.0),

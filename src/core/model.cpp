@@ -43,9 +43,7 @@ void Model::initialize() {
     margin_ = balls.size() ? 0.1 * sum / static_cast<double>(balls.size()) : 0.0;
   }
   // The speed cap of the automatic step needs the initial velocities before the first step.
-  max_speed_ = 0;
-  for (std::size_t i = 0; i < balls.size(); ++i)
-    max_speed_ = std::max(max_speed_, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
+  max_speed_ = fastest_point_speed();
   detect();
   force_displacement(0.0);
   const EnergyLedger e = energy();
@@ -60,9 +58,7 @@ void Model::cycle(std::int64_t count) {
   ensure_thread_buffers();
   if (adj_start_.size() != balls.size() + 1) { // balls added since the last detection
     detect();                                  // their contacts, adjacency and thread ranges
-    for (std::size_t i = 0; i < balls.size(); ++i)
-      max_speed_ =
-          std::max(max_speed_, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
+    max_speed_ = std::max(max_speed_, fastest_point_speed());
   }
   if (mass_scale_.size() != balls.size() && !mass_scale_.empty()) { // balls added or removed
     mass_scale_.clear();
@@ -88,6 +84,13 @@ void Model::cycle(std::int64_t count) {
       detect();
     force_displacement(dt);
   }
+}
+
+double Model::fastest_point_speed() const {
+  double v = 0;
+  for (std::size_t i = 0; i < balls.size(); ++i)
+    v = std::max(v, balls.vel[i].norm() + balls.radius[i] * balls.spin[i].norm());
+  return v;
 }
 
 double Model::estimate_timestep() const {

@@ -220,6 +220,8 @@ private:
   void law_of_motion(double dt);
   void track_motion(double dt);
   double estimate_timestep() const;
+  /// The largest speed of any ball surface point (centre speed + radius x spin) [m/s].
+  double fastest_point_speed() const;
   bool needs_detection() const;
 
   std::vector<Contact> contacts_;
