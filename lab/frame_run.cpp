@@ -372,12 +372,11 @@ LabSummary run_frame_test(FrameTest& test, const Protocol& p, const LabOptions& 
 }
 
 LabSummary run_lab_test(const Protocol& p, const LabOptions& o) {
-  const std::unique_ptr<FrameTest> test = make_frame_test(p.test);
-  return run_frame_test(*test, p, o);
+  return run_frame_test(*p.frame_test, p, o); // the test that read the protocol's options
 }
 
 LabSummary FrameTest::run(const nlohmann::json&, const std::string& file, const LabOptions& o) {
-  return run_frame_test(*this, load_protocol(file), o);
+  return run_lab_test(load_protocol(file), o);
 }
 
 void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {

@@ -17,7 +17,7 @@ class Model;
 /// Run one test in the frame. On any error nothing is left in OUTDIR. Throws InputError for bad
 /// input, PhysicsError for a blow-up.
 LabSummary run_frame_test(FrameTest& test, const Protocol& p, const LabOptions& o);
-/// The same for a protocol read by load_protocol (its test from the table).
+/// The same for a protocol read by load_protocol (its test, holding the options it read).
 LabSummary run_lab_test(const Protocol& p, const LabOptions& o);
 
 /// Material behind a protocol: the specimen (from its file, or made by genesis) and its metadata.

@@ -18,6 +18,64 @@ std::string resolve(const std::string& file, const std::string& p) {
   return (std::filesystem::path(file).parent_path() / path).lexically_normal().string();
 }
 
+namespace {
+
+void read_common_loading(JsonObject& l, Protocol& p) {
+  if (l.has("strain_rate") && l.has("platen_velocity"))
+    l.fail("strain_rate", "give either 'strain_rate' (1/s) or 'platen_velocity' (m/s), not both");
+  p.strain_rate = l.number("strain_rate", {0, 100, true, false}, kDefaultStrainRate, "1/s");
+  if (l.has("platen_velocity"))
+    p.platen_velocity = l.number("platen_velocity", {0, 100, true, false}, std::nullopt, "m/s");
+  p.ramp_steps = l.integer("ramp_steps", 0, 10'000'000, 2000);
+  p.seating_stress = l.number("seating_stress", Range::positive(), 1e5, "Pa");
+  p.density_scaling = l.number("density_scaling", Range::half_open(0, 1), 0.0);
+  if (l.has("timestep_safety"))
+    p.timestep_safety = l.number("timestep_safety", {0, 1.6, true, false}, std::nullopt);
+  if (l.has("platen_friction"))
+    p.platen_friction = l.number("platen_friction", Range::closed(0, 10), std::nullopt);
+}
+
+void read_common_stop(JsonObject& s, Protocol& p) {
+  p.post_peak_fraction = s.number("post_peak_fraction", {0, 1, true, true}, 0.9);
+  p.min_steps = s.integer("min_steps", 0, std::numeric_limits<std::int64_t>::max(), 1000);
+  p.strain_limit = s.number("strain_limit", Range::non_negative(), 0.0);
+  p.max_steps = s.integer("max_steps", 1, std::numeric_limits<std::int64_t>::max(), 5'000'000);
+}
+
+// A key this test does not read but another test does: named with the tests it applies to
+// (found by letting each other test read the same section), not as an unknown key.
+void refuse_other_tests_keys(JsonObject& section, const FrameTest& test) {
+  for (const std::string& key : section.unread()) {
+    nlohmann::json one = nlohmann::json::object();
+    one[key] = section.json().at(key);
+    std::vector<std::string> tests;
+    for (const std::string& name : frame_test_names()) {
+      if (name == test.name())
+        continue;
+      const std::unique_ptr<FrameTest> other = make_frame_test(name);
+      const nlohmann::json empty = nlohmann::json::object();
+      JsonObject probe(one, section.file(), section.path()), none(empty, "", "");
+      Protocol scratch;
+      for (const bool as_stop : {false, true}) {
+        try { // as a loading key, then as a stop key (a test that fails on the missing rest)
+          other->read_options(as_stop ? none : probe, as_stop ? probe : none, scratch);
+        } catch (const InputError&) {
+        }
+      }
+      if (probe.was_read(key))
+        tests.push_back(name);
+    }
+    if (tests.empty())
+      continue; // an unknown key: finish() lists the allowed ones
+    std::string list;
+    for (std::size_t i = 0; i < tests.size(); ++i)
+      list += (i ? " and " : "") + tests[i];
+    section.fail(key, "applies to the " + list + " test" + (tests.size() > 1 ? "s" : "") + " only");
+  }
+}
+
+} // namespace
+
 Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
                             const std::string& key_path) {
   Protocol p;
@@ -29,7 +87,8 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
   p.name = top.string("name", "");
   top.string("description", "");
   p.test = top.choice("test", frame_test_names());
-  const std::unique_ptr<FrameTest> test = make_frame_test(p.test);
+  p.frame_test = make_frame_test(p.test);
+  FrameTest& test = *p.frame_test;
   {
     if (!top.has("specimen"))
       top.fail("specimen", "missing: give {\"file\": SPECIMEN} or {\"material\": CARD}");
@@ -61,41 +120,13 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
         top.integer("seed", 0, std::numeric_limits<std::int64_t>::max()));
   {
     JsonObject l = top.optional_object("loading");
-    if (l.has("strain_rate") && l.has("platen_velocity"))
-      l.fail("strain_rate", "give either 'strain_rate' (1/s) or 'platen_velocity' (m/s), not both");
-    p.strain_rate = l.number("strain_rate", {0, 100, true, false}, kDefaultStrainRate, "1/s");
-    if (l.has("platen_velocity"))
-      p.platen_velocity = l.number("platen_velocity", {0, 100, true, false}, std::nullopt, "m/s");
-    p.ramp_steps = l.integer("ramp_steps", 0, 10'000'000, 2000);
-    p.seating_stress = l.number("seating_stress", Range::positive(), 1e5, "Pa");
-    p.confinement = l.number("confinement", Range::non_negative(), 0.0, "Pa");
-    p.confinement_tolerance = l.number("confinement_tolerance", {0, 0.5, true, false}, 0.01);
-    p.grip_fraction = l.number("grip_fraction", {0, 0.4, true, false}, 0.1);
-    p.reverse_at_strain = l.number("reverse_at_strain", {0, 0.1, false, false}, 0.0);
-    if (l.choice("jaws", {"flat", "curved"}, "flat") == "curved")
-      p.jaw_radius_ratio = l.number("jaw_radius_ratio", Range::closed(1.1, 10), 1.5);
-    else if (l.has("jaw_radius_ratio"))
-      l.fail("jaw_radius_ratio", "applies to \"jaws\": \"curved\" only");
-    p.density_scaling = l.number("density_scaling", Range::half_open(0, 1), 0.0);
-    if (l.has("timestep_safety"))
-      p.timestep_safety = l.number("timestep_safety", {0, 1.6, true, false}, std::nullopt);
-    if (l.has("platen_friction"))
-      p.platen_friction = l.number("platen_friction", Range::closed(0, 10), std::nullopt);
-    test->check_loading(l, p);
-    l.finish();
-  }
-  {
     JsonObject s = top.optional_object("stop");
-    p.post_peak_fraction = s.number("post_peak_fraction", {0, 1, true, true}, 0.9);
-    p.min_steps = s.integer("min_steps", 0, std::numeric_limits<std::int64_t>::max(), 1000);
-    p.strain_limit = s.number("strain_limit", Range::non_negative(), 0.0);
-    p.split_fraction = s.number("split_fraction", Range::closed(0, 1), 0.6);
-    p.failed_fraction = s.number("failed_fraction", {0, 1, true, false}, 0.3);
-    test->check_stop(s);
-    if (p.failed_fraction >= p.post_peak_fraction)
-      s.fail("failed_fraction",
-             "must be below stop.post_peak_fraction (" + format_double(p.post_peak_fraction) + ")");
-    p.max_steps = s.integer("max_steps", 1, std::numeric_limits<std::int64_t>::max(), 5'000'000);
+    read_common_loading(l, p);
+    read_common_stop(s, p);
+    test.read_options(l, s, p); // the test's own keys
+    refuse_other_tests_keys(l, test);
+    refuse_other_tests_keys(s, test);
+    l.finish();
     s.finish();
   }
   {

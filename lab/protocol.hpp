@@ -1,16 +1,20 @@
 // Protocol files of tests in the loading frame: what test to run on which specimen, how fast, when
-// to stop and what to write (docs/protocol-format.md). The test's own rules for its keys come
-// from its protocol (lab/protocols/). All quantities SI.
+// to stop and what to write (docs/protocol-format.md). These are the keys every test shares; a
+// test reads its own keys (confinement, grips, jaws, split rule, ...) into itself
+// (FrameTest::read_options, lab/protocols/). All quantities SI.
 #pragma once
 
 #include "materials/material_card.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <memory>
 #include <optional>
 #include <string>
 
 namespace rocklab {
+
+class FrameTest;
 
 /// Default loading rate: the quasi-static rate of docs/results.md (strain rate, 1/s).
 inline constexpr double kDefaultStrainRate = 1.0;
@@ -19,6 +23,8 @@ struct Protocol {
   std::string file; ///< the protocol file (paths inside it are relative to its folder)
   std::string name;
   std::string test = "ucs"; ///< the test's name in lab/protocol_table.cpp
+  /// The test, holding its own options as the file gave them (it runs the protocol).
+  std::shared_ptr<FrameTest> frame_test;
   // specimen: a specimen file, or a material card run through genesis first
   std::string specimen_file;
   std::string material_file;
@@ -30,12 +36,6 @@ struct Protocol {
   double platen_velocity = 0;              ///< > 0: speed of each platen (or grip) [m/s]
   std::int64_t ramp_steps = 2000;          ///< the platen speed rises smoothly over this many steps
   double seating_stress = 1e5;             ///< platens first close to this axial stress [Pa]
-  double confinement = 0;                  ///< triaxial confining stress [Pa]
-  double confinement_tolerance = 0.01;     ///< servo band during the confinement phase [-]
-  double grip_fraction = 0.1;              ///< direct tension: grips are grains this near an end
-  double reverse_at_strain = 0; ///< > 0: unload from this axial strain back to zero (elastic test)
-  /// Brazilian: 0 flat platens; > 0 curved jaws (ISRM 1978) of this times the disk's radius.
-  double jaw_radius_ratio = 0;
   /// >= 0: the platens' ball-facet friction coefficient (0 lubricated, steel on rock unlubricated
   /// about 0.2-0.5); < 0: the test's own (UCS, triaxial: 0; Brazilian: the specimen's wall rule).
   double platen_friction = -1;
@@ -49,10 +49,6 @@ struct Protocol {
   double post_peak_fraction = 0.9; ///< stop when the load falls to this fraction of its peak
   std::int64_t min_steps = 1000;   ///< ... but not before this many loading steps
   double strain_limit = 0;         ///< > 0: also stop at this axial strain [-]
-  /// Brazilian: the post-peak rule applies only once cracks near the loaded diameter cover this
-  /// fraction of it without a gap (a split, not crushing under the platens); 0: no check.
-  double split_fraction = 0.6;
-  double failed_fraction = 0.3; ///< Brazilian: stop without a split when the load falls this low
   std::int64_t max_steps = 5'000'000;
   // output
   std::int64_t history_every = 100; ///< a history row every this many steps

@@ -96,7 +96,7 @@ TEST(Robustness, AnOutputFolderThatIsAFileIsABadCommandLine) {
   std::ofstream(suite)
       << R"({"name": "s", "material": ")" + test::source_dir() +
              R"(/tests/data/lab_2d_fj.json", "tests": [{"name": "u", "test": "ucs"}]})";
-  for (const std::string cmd : {" test " + protocol.string(), " suite " + suite.string()}) {
+  for (const std::string& cmd : {" test " + protocol.string(), " suite " + suite.string()}) {
     std::string msg;
     EXPECT_EQ(test::run_command(test::binary() + cmd + " -o " + file.string() + " -q", &msg), 2)
         << msg;

@@ -96,15 +96,7 @@ void LoadingFrame::begin_loading() {
   shell_ref_.clear();
   for (std::int32_t i : shell_)
     shell_ref_.push_back(m_.balls.pos[static_cast<std::size_t>(i)]);
-  lateral_ref_.setZero();
-  if (!lateral_.empty()) {
-    if (lateral_axis_[0] < 0)
-      lateral_ref_[0] = m_.walls[static_cast<std::size_t>(lateral_[0])].cylinder_radius;
-    else
-      for (int d = 0; d < geo_.dim; ++d)
-        if (d != geo_.axis)
-          lateral_ref_[d] = lateral_width(d);
-  }
+  confinement_.mark_reference(m_, geo_);
   LabSample s;
   measure(s);
   load_ref_ = s.load;
@@ -191,8 +183,8 @@ void LoadingFrame::advance() {
   if (phase_ == kConfine || phase_ == kSeat) {
     // The platens (and confining walls) servo to their stress; loading begins once every wall is
     // within its band and the specimen is at rest.
-    const double target = phase_ == kConfine ? p_.confinement : p_.seating_stress;
-    const double tol = phase_ == kConfine ? p_.confinement_tolerance : 0.1;
+    const double target = phase_ == kConfine ? setup_.confinement : p_.seating_stress;
+    const double tol = phase_ == kConfine ? setup_.confinement_tolerance : 0.1;
     if (servoed_to(target, tol, since)) {
       record_history();
       begin_loading();
@@ -218,7 +210,7 @@ void LoadingFrame::advance() {
     samples_.push_back(current_);
     test_.sampled(*this, current_);
   }
-  if (!lateral_.empty())
+  if (confinement_.mounted())
     band_.add(current_.lateral_stress);
   track_peak();
   if (p_.vtk && p_.vtk_every_strain > 0 && phase_ == kLoad &&
@@ -237,14 +229,13 @@ void LoadingFrame::advance() {
 bool LoadingFrame::servoed_to(double target, double tol, std::int64_t since) const {
   if (since % 100 != 0 || since < 200)
     return false;
-  bool ok = std::abs(current_.axial_stress - target) <= tol * target;
-  for (std::size_t k = 0; k < lateral_.size(); ++k)
-    ok = ok && std::abs(lateral_stress_of(k) - target) <= tol * target;
+  const bool ok = std::abs(current_.axial_stress - target) <= tol * target &&
+                  confinement_.within(m_, geo_, wall_height(), target, tol);
   return ok && m_.mean_unbalanced_force_ratio() <= 1e-2;
 }
 
 void LoadingFrame::reseat() {
-  if (top_ < 0 || phase_ != kLoad || reseating_)
+  if (actuator_->wall() < 0 || phase_ != kLoad || reseating_)
     return;
   reseating_ = true;
   reseat_step_ = m_.step();
@@ -258,12 +249,7 @@ void LoadingFrame::track_peak() {
   peak_ = {current_.load,  current_.axial_strain,   current_.axial_stress,
            current_.force, current_.lateral_strain, current_.time,
            current_.step,  monitor_.tension(),      monitor_.shear()};
-  if (top_ >= 0) {
-    const double ft = m_.walls[static_cast<std::size_t>(top_)].force[geo_.axis];
-    const double fb = m_.walls[static_cast<std::size_t>(bottom_)].force[geo_.axis];
-    peak_.imbalance =
-        std::abs(ft) + std::abs(fb) > 0 ? std::abs(ft + fb) / (std::abs(ft) + std::abs(fb)) : 0.0;
-  }
+  peak_.imbalance = actuator_->imbalance(m_, geo_.axis);
   band_.peak_min = band_.min;
   band_.peak_max = band_.max;
   if (p_.vtk && m_.step() - peak_snap_step_ >= p_.history_every) {
@@ -274,8 +260,8 @@ void LoadingFrame::track_peak() {
 
 bool LoadingFrame::stop_rules() {
   const std::int64_t loading = m_.step() - load_start_step_;
-  if (phase_ == kLoad && p_.reverse_at_strain > 0 &&
-      current_.axial_strain >= p_.reverse_at_strain) {
+  if (phase_ == kLoad && setup_.reverse_at_strain > 0 &&
+      current_.axial_strain >= setup_.reverse_at_strain) {
     phase_ = kUnload;
     reverse_step_ = m_.step();
     record_history();
@@ -312,15 +298,14 @@ template <class A> void LoadingFrame::fields(A& a) {
   a("ramp_start_step", ramp_start_step_), a("reseating", reseating_), a("reseats", reseats_);
   a("reseat_step", reseat_step_);
   a("reload_peak", reload_peak_), a("reload_strain0", reload_strain0_);
-  a("top", top_), a("bottom", bottom_), a("lateral", lateral_), a("lateral_axis", lateral_axis_);
-  a("lateral_sign", lateral_sign_), a("grip_top", grip_top_), a("grip_bottom", grip_bottom_);
+  confinement_.fields(a); // the fixture's fields; the actuator's: state(), restore()
   a("shell", shell_), a("v_final", v_final_), a("sep_ref", sep_ref_), a("shell_ref", shell_ref_);
-  a("lateral_ref", lateral_ref_), a("load_ref", load_ref_), a("reference", reference_);
+  a("load_ref", load_ref_), a("reference", reference_);
   a.object("peak", peak_);
   if (p_.density_scaling > 0) // (checkpoints of runs without it keep their old fields)
     a.object("density_scaling", density_);
   a.object("confinement_band", band_);
-  a("servo_integral", servo_integral_), a("bond_break_events", bond_break_events_);
+  a("bond_break_events", bond_break_events_);
   a("next_snapshot_strain", next_snapshot_strain_), a("snapshot_due", snapshot_due_);
   a("peak_snap_step", peak_snap_step_), a("stop_reason", stop_reason_), a("history", history_);
   a("energy_start", energy_start_), a("energy_load", energy_load_);
@@ -330,6 +315,7 @@ nlohmann::json LoadingFrame::state() const {
   nlohmann::json s = nlohmann::json::object();
   JsonFieldWriter w{s};
   const_cast<LoadingFrame*>(this)->fields(w); // the writer only reads
+  actuator_->save(s);
   nlohmann::json samples = nlohmann::json::array();
   for (const LabSample& x : samples_)
     samples.push_back({x.step, x.time, x.axial_strain, x.lateral_strain, x.axial_stress,
@@ -350,20 +336,12 @@ void LoadingFrame::restore(const nlohmann::json& s, const std::string& file) {
     if (!ok)
       throw InputError(file + ": corrupt checkpoint (" + what + " out of range)");
   };
-  const auto walls = static_cast<std::int64_t>(m_.walls.size());
   const auto balls = static_cast<std::int32_t>(m_.balls.size());
   check(phase_ >= kConfine && phase_ <= kDone, "phase");
-  check((top_ == -1 && bottom_ == -1) ||
-            (top_ >= 0 && top_ < walls && bottom_ >= 0 && bottom_ < walls),
-        "platen wall");
-  check(top_ >= 0 || (!grip_top_.empty() && !grip_bottom_.empty()), "grips");
-  for (std::int64_t w : lateral_)
-    check(w >= 0 && w < walls, "confining wall");
-  check(lateral_axis_.size() == lateral_.size() && lateral_sign_.size() == lateral_.size(),
-        "confining wall");
-  for (const auto* list : {&grip_top_, &grip_bottom_, &shell_})
-    for (std::int32_t i : *list)
-      check(i >= 0 && i < balls, "grain index");
+  actuator_->restore(s, file, m_);
+  confinement_.check(m_, file);
+  for (std::int32_t i : shell_)
+    check(i >= 0 && i < balls, "grain index");
   check(shell_ref_.empty() || shell_ref_.size() == shell_.size(), "lateral-surface grains");
   const nlohmann::json& samples = r.at("samples");
   try {
@@ -436,8 +414,9 @@ nlohmann::json LoadingFrame::results() const {
   r["units"] = "SI (m, kg, s, N, Pa, J); stresses and strains compression positive";
   r["test"] = test_.name();
   r["stop_reason"] = stop_reason_;
+  const std::int64_t top = actuator_->wall();
   for (const ModelRule& rule : m_.rules) // the platens' friction, as the model has it
-    if (top_ >= 0 && rule.wall == top_ && std::holds_alternative<LinearProps>(rule.props))
+    if (top >= 0 && rule.wall == top && std::holds_alternative<LinearProps>(rule.props))
       r["platen_friction"] = std::get<LinearProps>(rule.props).fric;
   const double crack_area = [&] {
     double a = 0;

@@ -9,6 +9,8 @@
 
 #include "core/model.hpp"
 #include "lab/crack_monitor.hpp"
+#include "lab/frame/fixtures.hpp"
+#include "lab/frame/geometry.hpp"
 #include "lab/protocol.hpp"
 
 #include <nlohmann/json.hpp>
@@ -16,6 +18,7 @@
 #include <array>
 #include <cstdint>
 #include <iosfwd>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,39 +41,14 @@ struct LabSample {
   double force = 0;          ///< platen (grip) force [N], 2D per unit thickness
 };
 
-/// What loads the specimen.
-enum class Actuator { Platens, Grips };
-
-/// How a protocol wants the frame set up.
+/// How a test wants the frame set up (its fixtures: FrameTest::actuator and the confinement).
 struct FrameSetup {
   bool diametral = false; ///< a disk loaded across its diameter (y axis), else along the axis
-  Actuator actuator = Actuator::Platens; ///< platens, or grips holding the end grains (tension)
-  bool confined = false;                 ///< confining walls hold loading.confinement
+  double confinement = 0; ///< > 0: confining walls hold this stress [Pa]
+  double confinement_tolerance = 0.01; ///< the confining phase's band [-]
   bool platen_friction = false; ///< platens keep the specimen's wall friction (else lubricated)
   Phase first_phase = kSeat;    ///< kConfine, kSeat (platens close to the seating stress) or kLoad
-};
-
-/// The specimen as the frame measured it when the test began [m, m^2, m^3].
-struct SpecimenGeometry {
-  int dim = 3;
-  int axis = 2;           ///< loading axis: z (3D) / y (2D); a diametral test loads along y
-  bool round = false;     ///< cylinder (3D) cross-section
-  bool diametral = false; ///< a disk loaded across its diameter
-  Vec3 center = Vec3::Zero();
-  double height0 = 0;         ///< along the loading axis
-  Vec3 width0 = Vec3::Zero(); ///< extents across the axis (cylinder: the diameter)
-  double thickness = 1;       ///< disk thickness (2D: unit thickness)
-  double area0 = 0, volume = 0, r_avg = 0;
-  Vec3 lo = Vec3::Zero(), hi = Vec3::Zero(); ///< the grains' bounding box (2D: z = 0)
-
-  /// The length a strain rate refers to: the diameter across which a disk is loaded, else the
-  /// height.
-  double loaded_length() const { return diametral ? width0.y() : height0; }
-  template <class A> void fields(A& a) {
-    a("dim", dim), a("axis", axis), a("round", round), a("diametral", diametral);
-    a("center", center), a("height0", height0), a("width0", width0), a("thickness", thickness);
-    a("area0", area0), a("volume", volume), a("r_avg", r_avg), a("lo", lo), a("hi", hi);
-  }
+  double reverse_at_strain = 0; ///< > 0: unload from this axial strain back to zero [-]
 };
 
 /// The peak of the load and the state at it.
@@ -109,8 +87,8 @@ struct ConfinementBand {
 
 class LoadingFrame {
 public:
-  LoadingFrame(const Protocol& p, FrameTest& test, Model& m, const nlohmann::json& meta)
-      : p_(p), test_(test), m_(m), meta_(meta) {}
+  /// The test's fixtures and options are taken from `test` (read with the protocol).
+  LoadingFrame(const Protocol& p, FrameTest& test, Model& m, const nlohmann::json& meta);
 
   /// Measure the specimen, add the machine's walls and grips, start the first phase.
   void setup();
@@ -139,7 +117,8 @@ public:
   double separation() const;                  ///< platen or grip separation [m]
   std::int64_t load_start_step() const { return load_start_step_; }
   std::int64_t reverse_step() const { return reverse_step_; }
-  bool confined() const { return !lateral_.empty(); }
+  bool confined() const { return confinement_.mounted(); }
+  const FrameSetup& frame_setup() const { return setup_; }
   const ConfinementBand& confinement_band() const { return band_; }
   bool loading() const { return phase_ >= kLoad; }
   /// The platens lost the specimen while loading (a grain under a platen gave way and the load
@@ -151,8 +130,6 @@ public:
   /// Since the last re-seating ended: the largest load [Pa] and the axial strain [-] travelled.
   double reload_peak() const { return reload_peak_; }
   double reload_strain() const { return current_.axial_strain - reload_strain0_; }
-  /// Brazilian curved jaws: jaw_radius_ratio times the disk's radius (D as in 2F / (pi D t)) [m].
-  double jaw_radius() const { return p_.jaw_radius_ratio * 0.5 * geo_.width0.x(); }
   /// The current cross-section [m^2] (confined: the walls'; else widened by the lateral strain).
   double current_area(double lateral_strain) const;
   /// The specimen's volume now [m^3] (2D: area x unit thickness): the current section times the
@@ -172,26 +149,14 @@ private:
   void measure_specimen(const std::string& shape, bool diametral);
   void check_reachable_strain() const;
   LinearProps platen_contact(bool friction) const;
-  std::int64_t add_wall(Wall w, const LinearProps& props);
-  void add_platens(const LinearProps& props);
-  LinearProps platen_props(LinearProps props) const; ///< with loading.platen_friction
-  Wall curved_jaw(const std::string& name, int side) const;
-  void add_grips();
-  void add_confinement(const LinearProps& props);
   void find_shell();
   // measure.cpp
   void measure(LabSample& s) const;
-  double lateral_width(int d) const;
-  double face_area(std::size_t k) const;
-  double lateral_stress_of(std::size_t k) const;
+  double wall_height() const; ///< the confining walls' height: the platens' separation
   double lateral_strain() const;
   double shell_strain() const;
   // control.cpp
   void control();
-  void gather_wall_sums();
-  double servo_velocity(std::size_t wall, double target, double area, double stress) const;
-  double follow_velocity(std::size_t k) const;
-  void drive(double v);
   // loading_frame.cpp
   void record_history();
   void mark_energy_start();
@@ -208,13 +173,12 @@ private:
   FrameTest& test_;
   Model& m_;
   const nlohmann::json& meta_;
+  FrameSetup setup_;
   SpecimenGeometry geo_;
-  // machine parts
-  std::int64_t top_ = -1, bottom_ = -1; ///< platen walls; -1 in direct tension (grips)
-  std::vector<std::int64_t> lateral_;   ///< confining walls
-  std::vector<int> lateral_axis_;       ///< axis of each (-1: the cylinder)
-  std::vector<double> lateral_sign_;    ///< +1 for the wall on the + side
-  std::vector<std::int32_t> grip_top_, grip_bottom_, shell_;
+  // fixtures and gauges
+  std::unique_ptr<Actuator> actuator_; ///< platens, jaws or grips
+  ConfiningWalls confinement_;         ///< mounted when the test is confined
+  std::vector<std::int32_t> shell_;    ///< lateral-surface grains (the unconfined lateral gauge)
   // state
   int phase_ = kSeat;
   std::int64_t phase_start_step_ = 0, load_start_step_ = 0, reverse_step_ = -1;
@@ -227,16 +191,12 @@ private:
   double v_final_ = 0;               ///< platen (grip) speed while loading [m/s]
   double sep_ref_ = 0;               ///< platen or grip separation when loading began [m]
   std::vector<Vec3> shell_ref_;
-  Vec3 lateral_ref_ = Vec3::Zero(); ///< wall widths (cylinder radius in [0]) when loading began
-  double load_ref_ = 0;             ///< load when loading began (the seating stress)
-  std::vector<Vec3> reference_;     ///< grain positions when the test began
+  double load_ref_ = 0;         ///< load when loading began (the seating stress)
+  std::vector<Vec3> reference_; ///< grain positions when the test began
   PeakRecord peak_;
   DensityScaling density_; ///< what the density scaling did at the start of loading
   ConfinementBand band_;
-  std::vector<double> servo_integral_; ///< sum of the confinement error of each wall [Pa]
-  // per-step servo sums by wall index (derived each step, reused buffers)
-  std::vector<double> wall_k_, wall_f_, wall_fv_;
-  std::vector<int> lateral_of_wall_;
+  std::vector<double> wall_k_; ///< stiffness sum of each wall's contacts (servo gains, reused)
   std::int64_t bond_break_events_ = 0; ///< bond_break events seen (each becomes a crack)
   double next_snapshot_strain_ = 0;
   bool snapshot_due_ = false, peak_snap_due_ = false;

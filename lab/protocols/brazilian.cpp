@@ -1,13 +1,13 @@
 // Brazilian (indirect tension) test: a disk between flat platens that keep the specimen's wall
 // friction, loaded across its diameter. The disk has split when cracks within 0.2 D of the
-// loaded diameter cover stop.split_fraction of it in one run of tenths (bridging at most one
+// loaded diameter cover stosplit_fraction_ of it in one run of tenths (bridging at most one
 // empty tenth). The tensile strength is the largest 2F / (pi D t) before the disk lost the
 // tension it carries across that diameter (per unit platen force, by 40 %): after that the two
 // halves can carry more load as columns under flat platens, which is not the rock's tensile
 // strength, while scattered cracks of a disk whose bond strengths vary widely complete the crack
 // run long before the disk fails and leave that tension as it was. Without a split there is no
 // tensile strength, only a peak. The test ends once the disk has split and the load fell, or when
-// the load collapses below stop.failed_fraction of its peak without a split
+// the load collapses below stofailed_fraction_ of its peak without a split
 // (docs/protocol-format.md).
 #include "lab/protocols/brazilian.hpp"
 #include "lab/protocols/frame_protocol.hpp"
@@ -98,13 +98,27 @@ public:
   // 2: strength before the split; 4: one bridge; 5: re-seating after a collapse without a split;
   // 6: strength before the loss of the diametral tension
   int revision() const override { return 6; }
+  void read_options(JsonObject& loading, JsonObject& stop, const Protocol& p) override {
+    if (loading.choice("jaws", {"flat", "curved"}, "flat") == "curved")
+      jaw_ratio_ = loading.number("jaw_radius_ratio", Range::closed(1.1, 10), 1.5);
+    else if (loading.has("jaw_radius_ratio"))
+      loading.fail("jaw_radius_ratio", "applies to \"jaws\": \"curved\" only");
+    split_fraction_ = stop.number("split_fraction", Range::closed(0, 1), 0.6);
+    failed_fraction_ = stop.number("failed_fraction", {0, 1, true, false}, 0.3);
+    if (failed_fraction_ >= p.post_peak_fraction)
+      stop.fail("failed_fraction", "must be below stop.post_peak_fraction (" +
+                                       format_double(p.post_peak_fraction) + ")");
+  }
   FrameSetup setup() const override {
     FrameSetup s;
     s.diametral = true;
     s.platen_friction = true;
     return s;
   }
-  void check_stop(JsonObject&) const override {} // split_fraction and failed_fraction apply
+  std::unique_ptr<Actuator> actuator(const Protocol& p) const override {
+    return std::make_unique<Platens>(jaw_ratio_, p.platen_friction);
+  }
+
   void check_shape(const std::string& shape, const Protocol& p) const override {
     if (shape != "disk")
       throw InputError(
@@ -130,12 +144,12 @@ public:
     // along the loaded diameter ends the test, or a load collapse below failed_fraction that
     // re-seating the platens does not cure.
     const Protocol& p = f.protocol();
-    if (p.split_fraction <= 0)
+    if (split_fraction_ <= 0)
       return load_fell_reason(p);
     if (split_seen(f))
       return "the disk split and the load fell below " + format_double(p.post_peak_fraction) +
              " of its peak";
-    const double low = p.failed_fraction * f.peak().load;
+    const double low = failed_fraction_ * f.peak().load;
     if (f.current().load >= low || f.reseating())
       return "";
     // The load collapsed without a split. A grain that sticks out of the cut disk can carry the
@@ -151,34 +165,33 @@ public:
     // Reloading after a re-seating: give it the platen travel the disk needed to its peak.
     if (!reloaded && f.reload_strain() < f.peak().strain)
       return "";
-    return "the load fell below " + format_double(p.failed_fraction) +
+    return "the load fell below " + format_double(failed_fraction_) +
            " of its peak without a split along the loaded diameter" +
            (f.reseats() > 0 ? " (platens re-seated " + std::to_string(f.reseats()) + " times)"
                             : std::string());
   }
   void results(const LoadingFrame& f, nlohmann::json& r) const override {
-    const Protocol& p = f.protocol();
     const PeakRecord& peak = f.peak();
     r["platen_reseats"] = f.reseats(); // collapses without a split that re-seating cured
-    r["jaws"] = p.jaw_radius_ratio > 0
-                    ? nlohmann::json{{"shape", "curved"}, {"radius_m", f.jaw_radius()}}
+    r["jaws"] = jaw_ratio_ > 0
+                    ? nlohmann::json{{"shape", "curved"},
+                                     {"radius_m", curved_jaw_radius(jaw_ratio_, f.geometry())}}
                     : nlohmann::json{{"shape", "flat"}};
-    if (p.split_fraction <= 0) { // the split check is off: the peak, as the user asked
+    if (split_fraction_ <= 0) { // the split check is off: the peak, as the user asked
       r["tensile_strength_Pa"] = peak.load;
-      r["tensile_strength_method"] = "the peak of 2F/(pi D t) (stop.split_fraction 0)";
+      r["tensile_strength_method"] = "the peak of 2F/(pi D t) (stosplit_fraction_ 0)";
       r["peak_force_N"] = peak.force;
       r["peak_axial_strain"] = peak.strain;
       return;
     }
-    const std::int64_t split =
-        split_crack_step(f.cracks().cracks(), f.geometry(), p.split_fraction);
-    const TensionLoss loss = tension_loss(tension_, kTensionKept, p.failed_fraction,
+    const std::int64_t split = split_crack_step(f.cracks().cracks(), f.geometry(), split_fraction_);
+    const TensionLoss loss = tension_loss(tension_, kTensionKept, failed_fraction_,
                                           kTensionFloor * f.load_ref(), kTensionPersist);
     const std::int64_t lost = loss.step;
     r["split"] = {
         {"found", split >= 0},
         {"step", split},
-        {"fraction_required", p.split_fraction},
+        {"fraction_required", split_fraction_},
         // the tension across the diameter per unit platen force (2/pi elastic)
         {"tension_per_force", loss.reference},
         {"tension_lost_step", lost},
@@ -283,7 +296,7 @@ private:
   // Bins the cracks formed since the last check (results() finds the split's crack itself).
   bool split_seen(const LoadingFrame& f) {
     if (!bins_)
-      bins_.emplace(f.geometry(), f.protocol().split_fraction);
+      bins_.emplace(f.geometry(), split_fraction_);
     const auto& cracks = f.cracks().cracks();
     for (; scanned_ < cracks.size(); ++scanned_)
       split_ = bins_->add(cracks[scanned_]) || split_;
@@ -294,6 +307,10 @@ private:
   std::size_t scanned_ = 0;             ///< cracks already binned
   bool split_ = false;                  ///< the binned cracks make a split
   std::vector<TensionReading> tension_; ///< the diametral tension per unit force while loading
+  // options
+  double jaw_ratio_ = 0;         ///< curved jaws of this times the disk's radius; 0: flat platens
+  double split_fraction_ = 0.6;  ///< stop.split_fraction (0: no split check)
+  double failed_fraction_ = 0.3; ///< stop.failed_fraction
 };
 
 } // namespace

@@ -1,5 +1,6 @@
 #include "lab/protocols/compression.hpp"
 
+#include "io/json_input.hpp"
 #include "io/results.hpp"
 #include "lab/frame/curve_analysis.hpp"
 #include "lab/frame/elastic_fit.hpp"
@@ -7,6 +8,16 @@
 #include <cstdio>
 
 namespace rocklab {
+
+void CompressionTest::read_options(JsonObject& loading, JsonObject&, const Protocol&) {
+  reverse_at_strain_ = loading.number("reverse_at_strain", {0, 0.1, false, false}, 0.0);
+}
+
+FrameSetup CompressionTest::compression_setup() const {
+  FrameSetup s;
+  s.reverse_at_strain = reverse_at_strain_;
+  return s;
+}
 
 double CompressionTest::axial_strain(const LoadingFrame& f) const {
   return (f.sep_ref() - f.separation()) / f.sep_ref(); // platen shortening over the height
@@ -23,9 +34,10 @@ namespace {
 // the platens run at full speed (after the ramps at the start and the turn).
 void unloading_moduli(const LoadingFrame& f, nlohmann::json& r) {
   const Protocol& p = f.protocol();
+  const double reverse = f.frame_setup().reverse_at_strain;
   std::vector<LabSample> up, down;
   for (const LabSample& s : f.samples()) {
-    if (s.axial_strain < 0.2 * p.reverse_at_strain)
+    if (s.axial_strain < 0.2 * reverse)
       continue;
     if (s.step <= f.reverse_step()) {
       if (s.step >= f.load_start_step() + p.ramp_steps)
@@ -73,10 +85,11 @@ void CompressionTest::results(const LoadingFrame& f, nlohmann::json& r) const {
   r["peak_deviator_Pa"] = peak.load;
   r["peak_axial_strain"] = peak.strain;
   r["peak_lateral_strain"] = peak.lateral;
-  r["confinement_Pa"] = f.protocol().confinement;
+  const FrameSetup& setup = f.frame_setup();
+  r["confinement_Pa"] = setup.confinement;
   if (f.confined())
-    r["confinement_measured_Pa"] = f.confinement_band().json(f.protocol().confinement);
-  if (f.protocol().reverse_at_strain > 0)
+    r["confinement_measured_Pa"] = f.confinement_band().json(setup.confinement);
+  if (setup.reverse_at_strain > 0)
     unloading_moduli(f, r);
 }
 
@@ -93,7 +106,7 @@ void CompressionTest::print_results(const nlohmann::json& r) const {
 }
 
 void CompressionTest::add_to_suite(const nlohmann::json& r, SuiteValues& v) const {
-  v.s3.push_back(setup().confined ? json_number(r, "confinement_Pa", std::nan("")) : 0.0);
+  v.s3.push_back(json_number(r, "confinement_Pa", std::nan(""))); // 0 in a UCS
   v.s1.push_back(json_number(r, "peak_stress_Pa", std::nan("")));
 }
 

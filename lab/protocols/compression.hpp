@@ -11,6 +11,8 @@ namespace rocklab {
 
 class CompressionTest : public FrameTest {
 public:
+  /// loading.reverse_at_strain: > 0 unloads from this axial strain back to zero (elastic test).
+  void read_options(JsonObject& loading, JsonObject& stop, const Protocol& p) override;
   double axial_strain(const LoadingFrame& f) const override;
   void stresses(const LoadingFrame& f, LabSample& s) const override;
   void results(const LoadingFrame& f, nlohmann::json& r) const override;
@@ -21,6 +23,11 @@ public:
 
   /// The loading branch up to the peak with the crack count at each sample.
   static CurveInput curve(const LoadingFrame& f);
+
+protected:
+  /// The frame set-up of a compression test with its options (unconfined, seated first).
+  FrameSetup compression_setup() const;
+  double reverse_at_strain_ = 0; ///< loading.reverse_at_strain [-]
 };
 
 } // namespace rocklab

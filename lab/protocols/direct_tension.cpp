@@ -3,6 +3,7 @@
 // (docs/protocol-format.md).
 #include "lab/protocols/frame_protocol.hpp"
 
+#include "io/json_input.hpp"
 #include "io/results.hpp"
 #include "lab/frame/elastic_fit.hpp"
 
@@ -13,11 +14,18 @@ namespace {
 class DirectTensionTest final : public FrameTest {
 public:
   const char* name() const override { return "direct_tension"; }
+  void read_options(JsonObject& loading, JsonObject&, const Protocol& p) override {
+    grip_fraction_ = loading.number("grip_fraction", {0, 0.4, true, false}, 0.1);
+    if (p.platen_friction >= 0)
+      loading.fail("platen_friction", "a direct tension test has grips, not platens");
+  }
   FrameSetup setup() const override {
     FrameSetup s;
-    s.actuator = Actuator::Grips;
     s.first_phase = kLoad;
     return s;
+  }
+  std::unique_ptr<Actuator> actuator(const Protocol&) const override {
+    return std::make_unique<Grips>(grip_fraction_);
   }
   double axial_strain(const LoadingFrame& f) const override {
     return (f.separation() - f.sep_ref()) / f.geometry().height0; // elongation
@@ -50,6 +58,9 @@ public:
     if (r["tensile_strength_Pa"].is_number())
       print_tensile_strength(r);
   }
+
+private:
+  double grip_fraction_ = 0.1; ///< loading.grip_fraction: grips hold grains this near an end
 };
 
 } // namespace

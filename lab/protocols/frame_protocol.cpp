@@ -1,5 +1,5 @@
-// The defaults of a test in the loading frame: unconfined, no Brazilian stop keys, not a disk, and
-// the standard post-peak stop rule; the printout's tensile-strength line.
+// The defaults of a test in the loading frame: flat platens, not a disk, the standard post-peak
+// stop rule, each declared suite property as gathered; the printout's tensile-strength line.
 #include "lab/protocols/frame_protocol.hpp"
 
 #include "io/json_input.hpp"
@@ -9,19 +9,8 @@
 
 namespace rocklab {
 
-void FrameTest::check_loading(JsonObject& loading, const Protocol& p) const {
-  if (p.confinement > 0)
-    loading.fail("confinement", "only a triaxial test is confined (use \"test\": \"triaxial\")");
-  if (p.jaw_radius_ratio > 0 && !setup().diametral)
-    loading.fail("jaws", "curved jaws load Brazilian disks only");
-  if (p.platen_friction >= 0 && setup().actuator == Actuator::Grips)
-    loading.fail("platen_friction", "a direct tension test has grips, not platens");
-}
-
-void FrameTest::check_stop(JsonObject& stop) const {
-  if (stop.has("split_fraction") || stop.has("failed_fraction"))
-    stop.fail(stop.has("split_fraction") ? "split_fraction" : "failed_fraction",
-              "applies to Brazilian tests only");
+std::unique_ptr<Actuator> FrameTest::actuator(const Protocol& p) const {
+  return std::make_unique<Platens>(0.0, p.platen_friction);
 }
 
 void FrameTest::check_shape(const std::string& shape, const Protocol& p) const {

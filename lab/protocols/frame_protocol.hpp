@@ -1,7 +1,8 @@
-// A laboratory test in the loading frame (UCS, triaxial, Brazilian, direct tension, ...): how the
-// frame is set up, what its readings mean, when the test ends, what it reports and how it is
-// plotted. One file per test under lab/protocols/, one row in lab/protocol_table.cpp; the frame
-// (lab/frame/) and the run loop (lab/frame_run.cpp) do the rest. Units SI.
+// A laboratory test in the loading frame (UCS, triaxial, Brazilian, direct tension, ...): its own
+// protocol keys, the fixtures it mounts, what its readings mean, when it ends, what it reports,
+// prints and plots, and which material properties it gives suites and calibrations. One file per
+// test under lab/protocols/, one row in lab/protocol_table.cpp; the frame (lab/frame/) and the
+// run loop (lab/frame_run.cpp) do the rest. Units SI.
 #pragma once
 
 #include "lab/frame/loading_frame.hpp"
@@ -10,6 +11,7 @@
 
 #include <cmath>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -49,11 +51,14 @@ public:
   LabSummary run(const nlohmann::json& j, const std::string& file, const LabOptions& o) override;
   void print(const LabSummary& s, const std::string& out_dir) const override;
 
+  /// Reads the test's own keys of the protocol's "loading" and "stop" sections into the test
+  /// (`p`: the keys every test shares, already read). Default: none. A key another test reads is
+  /// refused naming that test (lab/protocol.cpp).
+  virtual void read_options(JsonObject& /*loading*/, JsonObject& /*stop*/, const Protocol& /*p*/) {}
+  /// How the frame is set up for this test, with the options read.
   virtual FrameSetup setup() const = 0;
-  /// Protocol keys whose rules depend on the test, checked where the protocol file reads them:
-  /// by default a test is not confined and has no Brazilian stop keys.
-  virtual void check_loading(JsonObject& loading, const Protocol& p) const;
-  virtual void check_stop(JsonObject& stop) const;
+  /// What carries the load (default: flat platens with the protocol's loading.platen_friction).
+  virtual std::unique_ptr<Actuator> actuator(const Protocol& p) const;
   /// The specimen's shape from its genesis record ("" without one): by default not a disk.
   virtual void check_shape(const std::string& shape, const Protocol& p) const;
   /// The axial strain of the current reading (called while loading) [-].

@@ -13,9 +13,17 @@ namespace {
 class TriaxialTest final : public CompressionTest {
 public:
   const char* name() const override { return "triaxial"; }
+  void read_options(JsonObject& loading, JsonObject& stop, const Protocol& p) override {
+    CompressionTest::read_options(loading, stop, p);
+    confinement_ = loading.number("confinement", Range::non_negative(), 0.0, "Pa");
+    if (!(confinement_ > 0))
+      loading.fail("confinement", "a triaxial test needs a confining stress > 0 Pa");
+    tolerance_ = loading.number("confinement_tolerance", {0, 0.5, true, false}, 0.01);
+  }
   FrameSetup setup() const override {
-    FrameSetup s;
-    s.confined = true;
+    FrameSetup s = compression_setup();
+    s.confinement = confinement_;
+    s.confinement_tolerance = tolerance_;
     s.first_phase = kConfine;
     return s;
   }
@@ -35,10 +43,10 @@ public:
     props["hoek_brown_sigma_c_Pa"] = env.has_hb ? number_or_null(env.hb_sigma_c) : none;
     props["envelope_points"] = env.points;
   }
-  void check_loading(JsonObject& loading, const Protocol& p) const override {
-    if (!(p.confinement > 0))
-      loading.fail("confinement", "a triaxial test needs a confining stress > 0 Pa");
-  }
+
+private:
+  double confinement_ = 0;  ///< loading.confinement [Pa]
+  double tolerance_ = 0.01; ///< loading.confinement_tolerance: the confining phase's band [-]
 };
 
 } // namespace

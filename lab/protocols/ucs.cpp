@@ -12,7 +12,7 @@ namespace {
 class UcsTest final : public CompressionTest {
 public:
   const char* name() const override { return "ucs"; }
-  FrameSetup setup() const override { return {}; }
+  FrameSetup setup() const override { return compression_setup(); }
   std::vector<SuiteProperty> suite_properties() const override {
     return {{"youngs_modulus_Pa"},
             {"poisson_ratio"},

@@ -366,6 +366,14 @@ void JsonObject::finish() const {
   }
 }
 
+std::vector<std::string> JsonObject::unread() const {
+  std::vector<std::string> keys;
+  for (auto it = j_.begin(); it != j_.end(); ++it)
+    if (!used_.count(it.key()))
+      keys.push_back(it.key());
+  return keys;
+}
+
 std::uint64_t fnv1a64(std::string_view text, std::uint64_t h) {
   for (unsigned char c : text) {
     h ^= c;

@@ -85,9 +85,14 @@ public:
                                                                    bool required = true);
   /// Fail on keys that were never read.
   void finish() const;
+  /// The keys present and not read so far (in the object's order).
+  std::vector<std::string> unread() const;
+  /// Whether `key` was read (present or not).
+  bool was_read(const std::string& key) const { return used_.count(key) > 0; }
 
   const std::string& file() const { return file_; }
   const std::string& path() const { return path_; }
+  const nlohmann::json& json() const { return j_; } ///< the object as given (nothing marked read)
   [[noreturn]] void fail(const std::string& key, const std::string& what) const;
 
 private:
