@@ -1,7 +1,7 @@
 // The table of laboratory tests by the name a protocol file gives in "test". Adding a test: its
 // file under lab/protocols/ (a FrameTest: set-up, readings, results, printout lines, plot markers
-// and the suite properties it measures), one row in protocol_table.cpp, its source line in
-// CMakeLists.txt, its docs and its test (docs/architecture.md, "Recipe: add a lab protocol").
+// and the suite properties it measures), one row in protocol_table.cpp (CMake builds every file in
+// lab/protocols/), its docs and its test (docs/architecture.md, "Recipe: add a lab protocol").
 #pragma once
 
 #include "lab/lab_protocol.hpp"

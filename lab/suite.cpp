@@ -10,7 +10,6 @@
 #include "materials/material_card.hpp"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -38,59 +37,7 @@ bool valid_name(const std::string& s) {
          s[0] != '.';
 }
 
-// Least-squares line y = a + b x; returns {a, b, r2}.
-std::array<double, 3> line_fit(const std::vector<double>& x, const std::vector<double>& y) {
-  const double n = static_cast<double>(x.size());
-  double sx = 0, sy = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    sx += x[i];
-    sy += y[i];
-  }
-  const double mx = sx / n, my = sy / n;
-  double sxx = 0, sxy = 0, syy = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) {
-    sxx += (x[i] - mx) * (x[i] - mx);
-    sxy += (x[i] - mx) * (y[i] - my);
-    syy += (y[i] - my) * (y[i] - my);
-  }
-  const double b = sxy / sxx;
-  const double r2 = syy > 0 ? sxy * sxy / (sxx * syy) : 1.0;
-  return {my - b * mx, b, r2};
-}
-
 } // namespace
-
-Envelope fit_envelope(const std::vector<double>& s3, const std::vector<double>& s1) {
-  Envelope e;
-  e.points = static_cast<int>(s3.size());
-  std::set<double> distinct(s3.begin(), s3.end());
-  if (distinct.size() >= 2) {
-    // Mohr-Coulomb: sigma1 = sigma_c + q sigma3, q = (1 + sin phi) / (1 - sin phi),
-    // c = sigma_c / (2 sqrt(q)).
-    const auto [a, q, r2] = line_fit(s3, s1);
-    if (q > 1 && a > 0) {
-      e.has_mc = true;
-      e.friction_angle_deg = std::asin((q - 1) / (q + 1)) * 180.0 / 3.14159265358979323846;
-      e.cohesion = a / (2 * std::sqrt(q));
-      e.r2_mc = r2;
-    }
-  }
-  if (distinct.size() >= 3) {
-    // Hoek-Brown for intact rock (s = 1): (sigma1 - sigma3)^2 = sigma_c^2 + m_i sigma_c sigma3,
-    // a straight line in sigma3 whose intercept gives sigma_c and slope m_i sigma_c.
-    std::vector<double> y;
-    for (std::size_t i = 0; i < s3.size(); ++i)
-      y.push_back((s1[i] - s3[i]) * (s1[i] - s3[i]));
-    const auto [a, b, r2] = line_fit(s3, y);
-    if (a > 0 && b > 0) {
-      e.has_hb = true;
-      e.hb_sigma_c = std::sqrt(a);
-      e.hb_mi = b / e.hb_sigma_c;
-      e.r2_hb = r2;
-    }
-  }
-  return e;
-}
 
 Suite load_suite(const std::string& path) {
   Suite s;
@@ -262,6 +209,23 @@ std::vector<Job> SuiteRun::run_tests(const std::map<std::string, std::string>& s
   return jobs;
 }
 
+// The headline properties, in the order rock engineers read them (E, nu, strengths, envelope):
+// summary.csv and the printed table show them first, then every other property a test declares
+// (table order).
+constexpr const char* kHeadline[] = {
+    "youngs_modulus_Pa", "poisson_ratio",      "ucs_Pa",      "bts_Pa",       "direct_tension_Pa",
+    "ucs_over_bts",      "friction_angle_deg", "cohesion_Pa", "hoek_brown_mi"};
+
+// Every property the frame tests declare, in table order, each once.
+std::vector<std::string> declared_properties() {
+  std::vector<std::string> names;
+  for (const std::string& test : frame_test_names())
+    for (const SuiteProperty& p : make_frame_test(test)->suite_properties())
+      if (std::find(names.begin(), names.end(), p.name) == names.end())
+        names.emplace_back(p.name);
+  return names;
+}
+
 // 3. The summary of the tests' results.
 struct SuiteSummary {
   nlohmann::json tests = nlohmann::json::array();
@@ -336,6 +300,14 @@ nlohmann::json SuiteSummary::properties() const {
 
 } // namespace
 
+std::vector<std::string> summary_columns() {
+  std::vector<std::string> cols(std::begin(kHeadline), std::end(kHeadline));
+  for (const std::string& name : declared_properties())
+    if (std::find(cols.begin(), cols.end(), name) == cols.end())
+      cols.push_back(name);
+  return cols;
+}
+
 nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
@@ -380,15 +352,12 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
   auto cell = [](const nlohmann::json& v) {
     return v.is_number() ? format_double(v.get<double>()) : std::string();
   };
-  std::string scsv = "material,youngs_modulus_Pa,poisson_ratio,ucs_Pa,bts_Pa,direct_tension_Pa,"
-                     "ucs_over_bts,friction_angle_deg,cohesion_Pa,hoek_brown_mi\n";
-  scsv += summary["material"].get<std::string>();
-  for (const char* k :
-       {"youngs_modulus_Pa", "poisson_ratio", "ucs_Pa", "bts_Pa", "direct_tension_Pa",
-        "ucs_over_bts", "friction_angle_deg", "cohesion_Pa", "hoek_brown_mi"}) {
-    scsv += ',';
-    scsv += cell(props[k]);
-  }
+  std::string scsv = "material";
+  for (const std::string& k : summary_columns())
+    scsv += "," + k;
+  scsv += "\n" + summary["material"].get<std::string>();
+  for (const std::string& k : summary_columns())
+    scsv += "," + cell(props.value(k, nlohmann::json()));
   scsv += "\n";
   write_text_file(out.staged("summary.json"), summary.dump(2) + "\n");
   write_text_file(out.staged("summary.csv"), scsv);
@@ -446,6 +415,14 @@ std::string summary_table(const nlohmann::json& sm) {
                 mpa(p["mohr_coulomb_r2"], 1).c_str(), mpa(p["hoek_brown_mi"], 1).c_str(),
                 p["envelope_points"].get<int>());
   t += line;
+  // Every other property a test declares (a new test's shows here without editing this table).
+  const std::set<std::string> printed(std::begin(kHeadline), std::end(kHeadline));
+  std::string more;
+  for (const std::string& name : declared_properties())
+    if (!printed.count(name))
+      more += (more.empty() ? "" : "   ") + name + " " + mpa(p.value(name, nlohmann::json()), 1);
+  if (!more.empty())
+    t += more + "\n";
   for (const auto& w : sm.value("warnings", nlohmann::json::array()))
     t += "warning: " + w.get<std::string>() + "\n";
   return t;

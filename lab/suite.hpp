@@ -32,16 +32,6 @@ struct Suite {
 /// file and the key, e.g. tests[2].loading.confinement).
 Suite load_suite(const std::string& path);
 
-/// Strength envelopes from (confinement, peak axial stress) pairs, SI.
-struct Envelope {
-  int points = 0;
-  double friction_angle_deg = 0, cohesion = 0, r2_mc = 0; ///< Mohr-Coulomb, >= 2 confinements
-  bool has_mc = false;
-  double hb_mi = 0, hb_sigma_c = 0, r2_hb = 0; ///< Hoek-Brown (intact, s = 1), >= 3 confinements
-  bool has_hb = false;
-};
-Envelope fit_envelope(const std::vector<double>& sigma3, const std::vector<double>& sigma1);
-
 struct SuiteOptions {
   std::string out_dir;
   std::string executable; ///< the rocklab binary that runs each test (this process's own)
@@ -54,7 +44,11 @@ struct SuiteOptions {
 /// Returns the summary. Nothing is left in OUTDIR when it fails or is interrupted.
 nlohmann::json run_suite(const Suite& s, const SuiteOptions& o);
 
-/// The printed table of a summary.
+/// summary.csv's property columns: the headline (E, nu, UCS, BTS, direct tension, UCS/BTS,
+/// friction angle, cohesion, m_i), then every other property a frame test declares (table order).
+std::vector<std::string> summary_columns();
+
+/// The printed table of a summary (the headline properties, then a line of the others).
 std::string summary_table(const nlohmann::json& summary);
 
 } // namespace rocklab

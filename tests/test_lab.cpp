@@ -6,6 +6,7 @@
 #include "contact/contact_bond.hpp"
 #include "io/json_input.hpp"
 #include "io/specimen.hpp"
+#include "lab/envelope.hpp"
 #include "lab/frame/loading_frame.hpp"
 #include "lab/frame_run.hpp"
 #include "lab/protocol_table.hpp"

@@ -4,8 +4,11 @@
 #include "lab/calibration/calibration_file.hpp"
 #include "lab/protocol_table.hpp"
 #include "lab/protocols/frame_protocol.hpp"
+#include "lab/suite.hpp"
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 
 using namespace rocklab;
 using nlohmann::json;
@@ -93,4 +96,25 @@ TEST(Printout, EveryDeclaredSuitePropertyIsASummaryKeyAndACalibrationTarget) {
   }
   EXPECT_EQ(static_cast<std::size_t>(declared), calibration::target_needs().size());
   EXPECT_EQ(std::string(calibration::target_needs().front().property), "youngs_modulus_Pa");
+}
+
+TEST(Printout, EveryDeclaredSuitePropertyIsAColumnOfTheSuiteTables) {
+  // summary.csv and the printed suite table list a property a test declares without an edit of
+  // their own: the headline first, then the others.
+  const std::vector<std::string> cols = summary_columns();
+  ASSERT_GE(cols.size(), 9u);
+  EXPECT_EQ(cols[0], "youngs_modulus_Pa");
+  EXPECT_EQ(cols[8], "hoek_brown_mi");
+  json props = {{"envelope_points", 3}, {"mohr_coulomb_r2", 0.99}};
+  for (const std::string& name : frame_test_names())
+    for (const SuiteProperty& p : make_frame_test(name)->suite_properties()) {
+      EXPECT_NE(std::find(cols.begin(), cols.end(), p.name), cols.end()) << p.name;
+      props[p.name] = 1.5;
+    }
+  const json summary = {
+      {"suite", "s"}, {"material", "m"}, {"tests", json::array()}, {"properties", props}};
+  const std::string table = summary_table(summary);
+  for (std::size_t k = 9; k < cols.size(); ++k)
+    EXPECT_NE(table.find(cols[k] + " 1.5"), std::string::npos) << cols[k] << "\n" << table;
+  EXPECT_NE(table.find("E 1.5e-09 GPa"), std::string::npos) << table;
 }

@@ -3,12 +3,14 @@
 // documented exit statuses (docs/errors.md) with nothing half-written left behind.
 #include "helpers.hpp"
 #include "io/json_input.hpp"
+#include "io/work_estimate.hpp"
 #include "mutate.hpp"
 
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <array>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -103,6 +105,68 @@ TEST(Robustness, AnOutputFolderThatIsAFileIsABadCommandLine) {
     EXPECT_NE(msg.find("rocklab: input error: " + file.string()), std::string::npos) << msg;
     EXPECT_EQ(test::read_file(file), "not a folder\n");
   }
+}
+
+// Issue 41: valid but huge inputs started work silently. The run's records that cannot fit in
+// memory are refused before it starts (exit 2 naming the file and the key, nothing written); a
+// run past an hour is announced with a warning.
+TEST(Robustness, HugeButValidRunsAreRefusedOrWarnedBeforeTheyStart) {
+  const fs::path dir = scratch("huge");
+  fs::create_directories(dir);
+  // A scene of 10 s at a time step of 1e-13 s with a history row every step: 1e14 rows.
+  nlohmann::json scene = read_json_file(test::source_dir() + "/examples/ball_drop.json");
+  scene["timestep"] = 1e-13;
+  scene["run"] = {{"time", 10.0}};
+  scene["history"]["every"] = 1;
+  // A drop test at 100,000 impact speeds (each to its max_time of 1 s, the exponent fitted).
+  nlohmann::json drop = read_json_file(test::source_dir() + "/lab/drops/berea_rockfall.json");
+  drop["impact_speeds"] = std::vector<double>(100000, 5.0);
+  drop["max_time"] = 1.0;
+  const fs::path scene_file = dir / "scene.json", drop_file = dir / "drop.json";
+  std::ofstream(scene_file) << scene.dump();
+  std::ofstream(drop_file) << drop.dump();
+  for (const auto& [cmd, file, key] :
+       std::vector<std::array<std::string, 3>>{{" run ", scene_file.string(), "history"},
+                                               {" test ", drop_file.string(), "impact_speeds"}}) {
+    const fs::path out = dir / "out";
+    std::string msg;
+    EXPECT_EQ(test::run_command(test::binary() + cmd + file + " -o " + out.string() + " -q", &msg),
+              2)
+        << msg;
+    EXPECT_NE(msg.find(file + ": key '" + key + "'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("GB; allowed: within 80 % of this machine's"), std::string::npos) << msg;
+    EXPECT_FALSE(fs::exists(out)) << msg;
+  }
+  // Past an hour: a warning with the estimate (the run itself is not started here).
+  WorkEstimate e;
+  e.steps = 1e9;
+  e.ball_steps = 1e13;
+  testing::internal::CaptureStderr();
+  testing::internal::CaptureStdout();
+  check_estimate(e, "big.json", "run", false);
+  const std::string out = testing::internal::GetCapturedStdout();
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(out.find("estimate     1e+09 steps (1e+13 grain-steps)"), std::string::npos) << out;
+  EXPECT_NE(err.find("warning: big.json: key 'run' asks for 1e+09 steps"), std::string::npos)
+      << err;
+  EXPECT_NE(err.find("days on"), std::string::npos) << err;
+  // An hour's work or less: no warning.
+  e.ball_steps = 1e6;
+  e.steps = 1e3;
+  testing::internal::CaptureStderr();
+  check_estimate(e, "small.json", "run", true);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+  // During a run, the pace measured after a minute (a time step that shrank once contacts
+  // formed): 1 % in 61 s projects to 102 min, half in 61 s to 2 min.
+  testing::internal::CaptureStderr();
+  warn_projection("slow.json", 0.01, 61);
+  warn_projection("fast.json", 0.5, 61);
+  const std::string pace = testing::internal::GetCapturedStderr();
+  EXPECT_NE(pace.find("warning: slow.json: 1 % done in 61 s: at this pace the stage takes about "
+                      "102 min"),
+            std::string::npos)
+      << pace;
+  EXPECT_EQ(pace.find("fast.json"), std::string::npos) << pace;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,10 +1,10 @@
-// The loading frame of the test machine: it measures the specimen, adds the platens (or grips)
-// and confining walls to the model, drives them (seating, confining servo, constant-rate loading,
-// unloading), reads force, strain and stress every step, keeps the records (history, fine samples,
-// peak, confinement band, cracks) and applies the stop rules. A protocol (lab/protocols/) says how
-// the frame is set up for its test and what the readings mean. Talks to the engine only through
-// the Model's public API and its event stream. Units SI; stresses and strains compression
-// positive.
+// The loading frame of the test machine, the machine loop: it measures the specimen, mounts the
+// test's fixtures (platens, curved jaws or grips; confining walls: lab/frame/fixtures.hpp),
+// drives them (seating, confining servo, constant-rate loading, unloading), reads force, strain
+// and stress every step, keeps the records (history, fine samples, peak, confinement band,
+// cracks) and applies the stop rules. A test (lab/protocols/) chooses the fixtures and says what
+// the readings mean. Talks to the engine only through the Model's public API and its event
+// stream. Units SI; stresses and strains compression positive.
 #pragma once
 
 #include "core/model.hpp"

@@ -311,6 +311,7 @@ nlohmann::json run_drop_test(const DropProtocol& p, const std::string& out_dir, 
                              const std::atomic<bool>* interrupt) {
   const auto t0 = std::chrono::steady_clock::now();
   OutputDir out(out_dir);
+  check_estimate(drop_estimate(p), p.file, "impact_speeds", !progress);
   std::string history = "impact_speed_m_s,time_s,step,kinetic_J,kinetic_rotational_J,strain_J,"
                         "plastic_J,friction_J,body_work_J,height_m,normal_velocity_m_s\n";
   std::vector<DropResult> results;

@@ -8,6 +8,7 @@
 
 #include "contact/registry.hpp"
 #include "core/clumps.hpp"
+#include "io/work_estimate.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -77,6 +78,9 @@ DropProtocol drop_protocol_from_json(const nlohmann::json& j, const std::string&
 /// Appends history rows (speed, time, energies of the rock) to `history` if given.
 DropResult run_drop(const DropProtocol& p, double speed, double exponent = 0,
                     std::string* history = nullptr);
+
+/// What the protocol asks for: every drop to max_time at its model's time step (upper bound).
+WorkEstimate drop_estimate(const DropProtocol& p);
 
 /// Run the protocol (all speeds, calibration if asked) and write OUT/results.json,
 /// restitution.csv, history.csv and restitution.svg (+ exponent.svg). Returns results.json.

@@ -4,7 +4,7 @@
 #include "lab/protocols/compression.hpp"
 
 #include "io/json_input.hpp"
-#include "lab/suite.hpp"
+#include "lab/envelope.hpp"
 
 namespace rocklab {
 

@@ -6,8 +6,7 @@
 #include "materials/genesis/stages.hpp"
 
 #include "io/input_error.hpp"
-
-#include <unistd.h>
+#include "io/work_estimate.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -74,11 +73,6 @@ double grains_in(const MaterialCard& c, double solid) {
     n += df * solid / grain_volume(c.dim, 0.5 * d_mid);
   }
   return n;
-}
-
-double physical_memory() {
-  const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && size > 0 ? static_cast<double>(pages) * static_cast<double>(size) : 0;
 }
 
 [[noreturn]] void refuse(const MaterialCard& c, const std::string& key, const std::string& what) {

@@ -99,7 +99,9 @@ public:
 
   double time() const { return time_; }
   std::int64_t step() const { return step_; }
-  double timestep() const { return dt_; }
+  double timestep() const { return dt_; } ///< the last cycle's time step [s] (0 before one)
+  /// The time step the next cycle will take: the fixed one, or the automatic estimate [s].
+  double estimate_timestep() const;
   double margin() const { return margin_; }
   const std::vector<Contact>& contacts() const { return contacts_; }
   /// Location, force, moment and stiffness of each contact (same index as contacts()).
@@ -219,7 +221,6 @@ private:
   // motion.cpp
   void law_of_motion(double dt);
   void track_motion(double dt);
-  double estimate_timestep() const;
   /// The largest speed of any ball surface point (centre speed + radius x spin) [m/s].
   double fastest_point_speed() const;
   bool needs_detection() const;

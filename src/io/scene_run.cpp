@@ -3,7 +3,9 @@
 #include "io/output_dir.hpp"
 #include "io/progress.hpp"
 #include "io/results.hpp"
+#include "io/work_estimate.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
@@ -33,6 +35,34 @@ void show_progress(ProgressLine& line, const Scene& scene, std::size_t stage, co
   line.show(buf, scene.stages.size() == 1 ? frac : -1);
 }
 
+// The history's text for `steps` more steps (about 24 bytes a value) [bytes].
+double history_bytes(const Scene& scene, double steps) {
+  if (scene.history.empty())
+    return 0;
+  return (steps / static_cast<double>(scene.history_every) + 2) *
+         (24.0 * static_cast<double>(scene.history.size()) + 1);
+}
+
+// The steps every stage asks for at the time step the model starts with (a stage that stops on
+// the unbalanced-force ratio counts at its max_cycles, or not at all without one) and the
+// history's text.
+WorkEstimate scene_estimate(const Scene& scene, const Model& m) {
+  WorkEstimate e;
+  for (const Stage& st : scene.stages) {
+    if (st.run.cycles > 0)
+      e.steps += static_cast<double>(st.run.cycles);
+    else if (st.run.time > 0 && m.estimate_timestep() > 0)
+      e.steps += st.run.time / m.estimate_timestep();
+    else if (st.run.max_cycles > 0)
+      e.steps += static_cast<double>(st.run.max_cycles);
+    else
+      e.open_ended = true;
+  }
+  e.ball_steps = e.steps * static_cast<double>(m.balls.size());
+  e.bytes = history_bytes(scene, e.steps);
+  return e;
+}
+
 } // namespace
 
 RunSummary run_scene(Scene& scene, const RunOptions& opts) {
@@ -44,6 +74,8 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
   ProgressLine progress("run", opts.progress);
 
   m.initialize();
+  check_estimate(scene_estimate(scene, m), scene.file, scene.history.empty() ? "run" : "history",
+                 !opts.progress);
   std::vector<Event> events;
   m.drain_events(events);
   summary.events.add(events);
@@ -83,10 +115,25 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
         return false;
       return m.mean_unbalanced_force_ratio(true) < run.ratio;
     };
+    const auto stage_t0 = clock::now();
+    bool projected = false; // the stage's projected wall time was checked
     while (!done()) {
       if (opts.interrupt && opts.interrupt->load())
         throw std::runtime_error("interrupted; nothing was written to " + opts.out_dir);
       m.cycle(1);
+      // A stiffness that acts only once contacts form shrinks the time step after set-up (a
+      // stiff floor under a falling ball): after a minute, the stage's measured pace is
+      // projected to its end and warned about like the set-up's estimate.
+      if (!projected && m.step() % 1024 == 0) {
+        const double wall = std::chrono::duration<double>(clock::now() - stage_t0).count();
+        const double frac =
+            run.cycles > 0 ? static_cast<double>(m.step() - step0) / static_cast<double>(run.cycles)
+                           : (run.time > 0 ? (m.time() - time0) / run.time : 0);
+        if (wall > 60 && frac > 0) {
+          projected = true;
+          warn_projection(scene.file, frac, wall);
+        }
+      }
       events.clear();
       m.drain_events(events);
       summary.events.add(events);
