@@ -10,9 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iomanip>
 #include <numbers>
-#include <sstream>
 
 namespace rocklab::genesis {
 
@@ -37,9 +35,7 @@ constexpr double kMinInstallStrain = 1e-10;
 constexpr double kMaxInstallStrain = 0.05;
 
 std::string num(double v) {
-  std::ostringstream s;
-  s << std::setprecision(4) << v;
-  return s.str();
+  return message_number(v, 4);
 }
 
 double smallest_dimension(const ShapeSpec& s) {

@@ -23,9 +23,7 @@ constexpr double kSecondsPerStep = 8e-6;
 constexpr double kWarnSeconds = 3600;
 
 std::string num(double v) {
-  std::ostringstream s;
-  s << std::setprecision(3) << v;
-  return s.str();
+  return message_number(v, 3);
 }
 
 std::string duration(double s) {
@@ -39,6 +37,12 @@ std::string duration(double s) {
 }
 
 } // namespace
+
+std::string message_number(double v, int digits) {
+  std::ostringstream s;
+  s << std::setprecision(digits) << v;
+  return s.str();
+}
 
 double physical_memory() {
   const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);

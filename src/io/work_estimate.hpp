@@ -16,6 +16,9 @@ struct WorkEstimate {
   bool open_ended = false; ///< a stage ends on a condition and has no step cap (not counted)
 };
 
+/// A number for a message: `digits` significant digits, as iostream prints them (1e+09, 0.5).
+std::string message_number(double v, int digits);
+
 /// The machine's physical memory [bytes] (0 when unknown).
 double physical_memory();
 
