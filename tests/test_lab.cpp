@@ -571,6 +571,30 @@ TEST(Lab, CurvedJawsLoadTheDiskOverAnArcAndSplitIt) {
   EXPECT_EQ(r["platen_reseats"].get<int>(), 0);
 }
 
+// stop.split_fraction 0 turns the split check off: the strength is the peak, and results.json
+// says so (a rename once mangled this text into "stosplit_fraction_ 0").
+TEST(Lab, ABrazilianTestWithoutTheSplitCheckReportsThePeak) {
+  flat_disk_run();
+  const std::string spec = (test::scratch_root() / "bz_flat" / "specimen.rlspec").string();
+  const LabSummary s = run("bz_nosplit",
+                           {{"test", "brazilian"},
+                            {"specimen", {{"file", spec}}},
+                            {"stop", {{"split_fraction", 0.0}}},
+                            {"output", {{"vtk", false}, {"plots", false}}}},
+                           scratch("bz_nosplit"));
+  const nlohmann::json& r = s.results;
+  EXPECT_EQ(r["tensile_strength_method"], "the peak of 2F/(pi D t) (stop.split_fraction 0)");
+  // The peak of 2F / (pi D t) (2D: t = 1 m).
+  const double d = r["specimen"]["diameter_m"].get<double>();
+  const double t = r["specimen"]["thickness_m"].get<double>();
+  EXPECT_GT(r["tensile_strength_Pa"].get<double>(), 0.0);
+  EXPECT_TRUE(test::near_rel(r["tensile_strength_Pa"].get<double>(),
+                             2 * r["peak_force_N"].get<double>() / (std::numbers::pi * d * t),
+                             1e-12))
+      << r.dump(1);
+  EXPECT_FALSE(r.contains("split")) << r.dump(1);
+}
+
 TEST(Lab, ABrazilianDiskThatLosesItsPlatenGrainsIsReseatedAndSplits) {
   // The fifth 2D acceptance run's seed 3: a grain sticking out of the cut disk carried the whole
   // platen load; when its bonds broke it slid aside, the load fell to nothing, and the test

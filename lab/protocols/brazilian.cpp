@@ -1,13 +1,13 @@
 // Brazilian (indirect tension) test: a disk between flat platens that keep the specimen's wall
 // friction, loaded across its diameter. The disk has split when cracks within 0.2 D of the
-// loaded diameter cover stosplit_fraction_ of it in one run of tenths (bridging at most one
+// loaded diameter cover stop.split_fraction of it in one run of tenths (bridging at most one
 // empty tenth). The tensile strength is the largest 2F / (pi D t) before the disk lost the
 // tension it carries across that diameter (per unit platen force, by 40 %): after that the two
 // halves can carry more load as columns under flat platens, which is not the rock's tensile
 // strength, while scattered cracks of a disk whose bond strengths vary widely complete the crack
 // run long before the disk fails and leave that tension as it was. Without a split there is no
 // tensile strength, only a peak. The test ends once the disk has split and the load fell, or when
-// the load collapses below stofailed_fraction_ of its peak without a split
+// the load collapses below stop.failed_fraction of its peak without a split
 // (docs/protocol-format.md).
 #include "lab/protocols/brazilian.hpp"
 #include "lab/protocols/frame_protocol.hpp"
@@ -179,7 +179,7 @@ public:
                     : nlohmann::json{{"shape", "flat"}};
     if (split_fraction_ <= 0) { // the split check is off: the peak, as the user asked
       r["tensile_strength_Pa"] = peak.load;
-      r["tensile_strength_method"] = "the peak of 2F/(pi D t) (stosplit_fraction_ 0)";
+      r["tensile_strength_method"] = "the peak of 2F/(pi D t) (stop.split_fraction 0)";
       r["peak_force_N"] = peak.force;
       r["peak_axial_strain"] = peak.strain;
       return;
