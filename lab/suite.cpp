@@ -352,12 +352,13 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
   auto cell = [](const nlohmann::json& v) {
     return v.is_number() ? format_double(v.get<double>()) : std::string();
   };
+  const std::vector<std::string> columns = summary_columns();
   std::string scsv = "material";
-  for (const std::string& k : summary_columns())
-    scsv += "," + k;
-  scsv += "\n" + summary["material"].get<std::string>();
-  for (const std::string& k : summary_columns())
-    scsv += "," + cell(props.value(k, nlohmann::json()));
+  for (const std::string& k : columns)
+    scsv.append(",").append(k);
+  scsv.append("\n").append(summary["material"].get<std::string>());
+  for (const std::string& k : columns)
+    scsv.append(",").append(cell(props.value(k, nlohmann::json())));
   scsv += "\n";
   write_text_file(out.staged("summary.json"), summary.dump(2) + "\n");
   write_text_file(out.staged("summary.csv"), scsv);
@@ -420,7 +421,10 @@ std::string summary_table(const nlohmann::json& sm) {
   std::string more;
   for (const std::string& name : declared_properties())
     if (!printed.count(name))
-      more += (more.empty() ? "" : "   ") + name + " " + mpa(p.value(name, nlohmann::json()), 1);
+      more.append(more.empty() ? "" : "   ")
+          .append(name)
+          .append(" ")
+          .append(mpa(p.value(name, nlohmann::json()), 1));
   if (!more.empty())
     t += more + "\n";
   for (const auto& w : sm.value("warnings", nlohmann::json::array()))

@@ -62,7 +62,7 @@ void Platens::mount(Model& m, const SpecimenGeometry& g, const LinearProps& cont
     return;
   }
   const Vec3 e = unit_axis(g.axis);
-  const double span = 3 * std::max({g.width0.maxCoeff(), g.height0, g.thickness});
+  const double span = g.machine_span();
   Vec3 ptop = g.center, pbot = g.center;
   ptop[g.axis] = g.hi[g.axis];
   pbot[g.axis] = g.lo[g.axis];

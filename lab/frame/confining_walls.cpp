@@ -27,7 +27,7 @@ void ConfiningWalls::mount(Model& m, const SpecimenGeometry& g, const LinearProp
     axis_.push_back(-1);
     sign_.push_back(1);
   } else {
-    const double span = 3 * std::max({g.width0.maxCoeff(), g.height0, g.thickness});
+    const double span = g.machine_span();
     for (int d = 0; d < g.dim; ++d) {
       if (d == g.axis)
         continue;
@@ -172,8 +172,6 @@ void ConfiningWalls::control(Model& m, const SpecimenGeometry& g, double h, doub
   // integral trim (time constant 100 steps, limited to 5 % of the confinement) against any
   // remaining bias.
   gather_follow_sums(m);
-  if (integral_.size() != walls_.size())
-    integral_.assign(walls_.size(), 0.0);
   for (std::size_t k = 0; k < walls_.size(); ++k) {
     const auto wall = static_cast<std::size_t>(walls_[k]);
     const double s = stress(m, g, h, k);
@@ -194,7 +192,8 @@ void ConfiningWalls::control(Model& m, const SpecimenGeometry& g, double h, doub
 
 void ConfiningWalls::check(const Model& m, const std::string& file) const {
   const auto walls = static_cast<std::int64_t>(m.walls.size());
-  bool ok = axis_.size() == walls_.size() && sign_.size() == walls_.size();
+  bool ok = axis_.size() == walls_.size() && sign_.size() == walls_.size() &&
+            integral_.size() == walls_.size();
   for (std::int64_t w : walls_)
     ok = ok && w >= 0 && w < walls;
   if (!ok)

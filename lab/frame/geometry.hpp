@@ -4,6 +4,8 @@
 
 #include "core/types.hpp"
 
+#include <algorithm>
+
 namespace rocklab {
 
 struct SpecimenGeometry {
@@ -21,6 +23,8 @@ struct SpecimenGeometry {
   /// The length a strain rate refers to: the diameter across which a disk is loaded, else the
   /// height.
   double loaded_length() const { return diametral ? width0.y() : height0; }
+  /// How far the machine's plane walls reach across: three times the specimen's largest size.
+  double machine_span() const { return 3 * std::max({width0.maxCoeff(), height0, thickness}); }
   template <class A> void fields(A& a) {
     a("dim", dim), a("axis", axis), a("round", round), a("diametral", diametral);
     a("center", center), a("height0", height0), a("width0", width0), a("thickness", thickness);

@@ -5,7 +5,6 @@
 #include "io/results.hpp"
 #include "io/work_estimate.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <stdexcept>
@@ -14,16 +13,22 @@ namespace rocklab {
 
 namespace {
 
+// How far a stage is: the fraction of its cycles or of its time; -1 for a stage that stops on the
+// unbalanced-force ratio.
+double stage_fraction(const RunSpec& run, const Model& m, std::int64_t step0, double time0) {
+  if (run.cycles > 0)
+    return static_cast<double>(m.step() - step0) / static_cast<double>(run.cycles);
+  if (run.time > 0)
+    return (m.time() - time0) / run.time;
+  return -1;
+}
+
 // The state of a running stage: its step and time, and how far it is (cycles or time) or its
 // unbalanced-force ratio; the ETA only for a one-stage scene, where the fraction is the run's.
 void show_progress(ProgressLine& line, const Scene& scene, std::size_t stage, const Model& m,
                    std::int64_t step0, double time0) {
   const RunSpec& run = scene.stages[stage].run;
-  double frac = -1;
-  if (run.cycles > 0)
-    frac = static_cast<double>(m.step() - step0) / static_cast<double>(run.cycles);
-  else if (run.time > 0)
-    frac = (m.time() - time0) / run.time;
+  const double frac = stage_fraction(run, m, step0, time0);
   char buf[160];
   const int n = std::snprintf(buf, sizeof buf, "stage %zu/%zu  step %lld  t %.4g s  ", stage + 1,
                               scene.stages.size(), static_cast<long long>(m.step()), m.time());
@@ -48,11 +53,12 @@ double history_bytes(const Scene& scene, double steps) {
 // history's text.
 WorkEstimate scene_estimate(const Scene& scene, const Model& m) {
   WorkEstimate e;
+  const double dt = m.estimate_timestep();
   for (const Stage& st : scene.stages) {
     if (st.run.cycles > 0)
       e.steps += static_cast<double>(st.run.cycles);
-    else if (st.run.time > 0 && m.estimate_timestep() > 0)
-      e.steps += st.run.time / m.estimate_timestep();
+    else if (st.run.time > 0 && dt > 0)
+      e.steps += st.run.time / dt;
     else if (st.run.max_cycles > 0)
       e.steps += static_cast<double>(st.run.max_cycles);
     else
@@ -126,9 +132,7 @@ RunSummary run_scene(Scene& scene, const RunOptions& opts) {
       // projected to its end and warned about like the set-up's estimate.
       if (!projected && m.step() % 1024 == 0) {
         const double wall = std::chrono::duration<double>(clock::now() - stage_t0).count();
-        const double frac =
-            run.cycles > 0 ? static_cast<double>(m.step() - step0) / static_cast<double>(run.cycles)
-                           : (run.time > 0 ? (m.time() - time0) / run.time : 0);
+        const double frac = stage_fraction(run, m, step0, time0);
         if (wall > 60 && frac > 0) {
           projected = true;
           warn_projection(scene.file, frac, wall);
