@@ -162,30 +162,56 @@ int calibrate_check(const std::string& file) {
   for (const cal::CardParam& p : c.params)
     std::printf("parameter    %-36s %-15s start %.4g in [%.4g, %.4g]\n", p.key.c_str(),
                 cal::role_name(p.param.role), p.param.value, p.param.lo, p.param.hi);
-  std::printf("budget       elastic %d, strength %d, ratios %d, polish %d (+1 final)\n",
-              c.budget.elastic, c.budget.strength, c.budget.ratios, c.budget.polish);
+  std::printf("budget       elastic %d, strength %d, ratios %d, polish %d (+1 final); seeds up "
+              "to %d where the noise hides a miss; validation on %d-%d fresh seeds from %llu\n",
+              c.budget.elastic, c.budget.strength, c.budget.ratios, c.budget.polish,
+              c.budget.max_seeds > 0 ? c.budget.max_seeds
+                                     : std::max(static_cast<int>(c.seeds.size()), 6),
+              c.budget.validation_min, c.budget.validation_max,
+              static_cast<unsigned long long>(c.budget.validation_first));
   return 0;
 }
 
-int calibrate_command(const std::string& file, const std::string& out_dir, bool quiet, int jobs) {
+rocklab::calibration::EvaluatorOptions calibrate_options(const std::string& out_dir, int jobs) {
   rocklab::calibration::EvaluatorOptions o;
   o.out_dir = out_dir;
   o.executable = std::filesystem::read_symlink("/proc/self/exe").string();
   o.jobs = jobs;
   o.interrupt = &g_interrupt;
+  return o;
+}
+
+// --check --pilot: the plan, then the start card's tests on the file's seeds and the seeds each
+// target needs.
+int calibrate_pilot(const std::string& file, const std::string& out_dir, int jobs) {
+  calibrate_check(file);
+  std::fflush(stdout);
+  std::printf("%s",
+              rocklab::calibration::run_pilot(file, calibrate_options(out_dir, jobs)).c_str());
+  return 0;
+}
+
+int calibrate_command(const std::string& file, const std::string& out_dir, bool quiet, int jobs) {
+  rocklab::calibration::EvaluatorOptions o = calibrate_options(out_dir, jobs);
   const rocklab::calibration::Ranks ranks; // MPI when started by mpirun
   o.ranks = &ranks;
   o.progress = !quiet;
   if (ranks.size() > 1 && jobs == 0)
     o.jobs = 1; // one test process per rank unless asked: mpirun places the ranks on the cores
   const rocklab::calibration::CampaignSummary cs = rocklab::calibration::run_campaign(file, o);
-  if (!quiet && ranks.root())
-    std::printf("calibration  %s: %zu evaluations (%d suites run, %d cached), %.1f s\n"
-                "wrote        %s/card.json, report.md, convergence.csv, convergence.svg\n",
+  const bool validated = cs.validation_seeds == 0 || cs.validation_met;
+  if (!quiet && ranks.root()) {
+    std::printf("calibration  %s: %zu evaluations (%d suites run, %d cached), %.1f s\n",
                 cs.outcome.met ? "every target met" : "NOT every target met",
-                cs.outcome.history.size(), cs.suites_run, cs.suites_cached, cs.wall_seconds,
+                cs.outcome.history.size(), cs.suites_run, cs.suites_cached, cs.wall_seconds);
+    if (cs.validation_seeds > 0)
+      std::printf("validation   %s on %d fresh seeds (report.md)\n",
+                  cs.validation_met ? "every target met" : "NOT every target met",
+                  cs.validation_seeds);
+    std::printf("wrote        %s/card.json, report.md, convergence.csv, convergence.svg\n",
                 out_dir.c_str());
-  return cs.outcome.met ? 0 : 1;
+  }
+  return cs.outcome.met && validated ? 0 : 1;
 }
 
 int suite_command(const std::string& suite_file, const std::string& out_dir, bool quiet,
@@ -233,8 +259,14 @@ int info_command() {
 struct CalibrateArgs {
   std::string file, out;
   int jobs = 0;
-  bool check = false;
+  bool check = false, pilot = false;
 };
+
+int calibrate_dispatch(const CalibrateArgs& a, bool quiet) {
+  if (a.pilot)
+    return calibrate_pilot(a.file, a.out, a.jobs);
+  return a.check ? calibrate_check(a.file) : calibrate_command(a.file, a.out, quiet, a.jobs);
+}
 
 CLI::App* add_calibrate(CLI::App& app, CalibrateArgs& a, bool& quiet) {
   CLI::App* c = app.add_subcommand(
@@ -248,7 +280,12 @@ CLI::App* add_calibrate(CLI::App& app, CalibrateArgs& a, bool& quiet) {
                 "Test processes at once (0: one per core; under mpirun: per rank)")
       ->check(CLI::NonNegativeNumber);
   c->add_flag("-q,--quiet", quiet, "No summary");
-  c->add_flag("--check", a.check, "Check the file and print the plan; run nothing");
+  CLI::Option* check =
+      c->add_flag("--check", a.check, "Check the file and print the plan; run nothing");
+  c->add_flag("--pilot", a.pilot,
+              "With --check: run the start card's tests on the file's seeds and print the seeds "
+              "each target needs for its tolerance (kept in OUT/evaluations/)")
+      ->needs(check);
   return c;
 }
 
@@ -408,8 +445,7 @@ int main(int argc, char** argv) {
     if (*info)
       return info_command();
     if (*calib)
-      return cal.check ? calibrate_check(cal.file)
-                       : calibrate_command(cal.file, cal.out, quiet, cal.jobs);
+      return calibrate_dispatch(cal, quiet);
     return 0;
   });
 }

@@ -1,5 +1,6 @@
 #include "lab/envelope.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <set>
@@ -33,6 +34,8 @@ std::array<double, 3> line_fit(const std::vector<double>& x, const std::vector<d
 Envelope fit_envelope(const std::vector<double>& s3, const std::vector<double>& s1) {
   Envelope e;
   e.points = static_cast<int>(s3.size());
+  for (double x : s3)
+    e.sigma3_max = std::max(e.sigma3_max, x);
   std::set<double> distinct(s3.begin(), s3.end());
   if (distinct.size() >= 2) {
     // Mohr-Coulomb: sigma1 = sigma_c + q sigma3, q = (1 + sin phi) / (1 - sin phi),
@@ -57,6 +60,12 @@ Envelope fit_envelope(const std::vector<double>& s3, const std::vector<double>& 
       e.hb_sigma_c = std::sqrt(a);
       e.hb_mi = b / e.hb_sigma_c;
       e.r2_hb = r2;
+      double q = 0; // sigma1 = sigma3 + sigma_c sqrt(m_i sigma3 / sigma_c + 1)
+      for (std::size_t i = 0; i < s3.size(); ++i) {
+        const double fit = s3[i] + e.hb_sigma_c * std::sqrt(e.hb_mi * s3[i] / e.hb_sigma_c + 1);
+        q += (fit / s1[i] - 1) * (fit / s1[i] - 1);
+      }
+      e.hb_fit_error = std::sqrt(q / static_cast<double>(s3.size()));
     }
   }
   return e;

@@ -13,7 +13,10 @@ struct Envelope {
   double friction_angle_deg = 0, cohesion = 0, r2_mc = 0; ///< Mohr-Coulomb, >= 2 confinements
   bool has_mc = false;
   double hb_mi = 0, hb_sigma_c = 0, r2_hb = 0; ///< Hoek-Brown (intact, s = 1), >= 3 confinements
+  /// Root-mean-square of (fitted sigma1 - measured sigma1) / measured sigma1 over the points
+  double hb_fit_error = 0;
   bool has_hb = false;
+  double sigma3_max = 0; ///< the highest confinement fitted [Pa]
 };
 Envelope fit_envelope(const std::vector<double>& sigma3, const std::vector<double>& sigma1);
 

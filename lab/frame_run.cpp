@@ -234,7 +234,7 @@ PlotDocuments plot_documents(const FrameTest& test, const LoadingFrame& f,
                              const nlohmann::json& meta, const nlohmann::json& r,
                              const EventClustering& ev) {
   const PlotLabels labels = test.plot_labels();
-  PlotSeries axial{"axial stress vs axial strain", {}, {}, "#000000"};
+  PlotSeries axial{labels.curve, {}, {}, "#000000"};
   PlotSeries lateral{"axial stress vs lateral strain", {}, {}, "#7f7f7f", true};
   PlotSeries volumetric{"axial stress vs volumetric strain", {}, {}, "#2ca02c", true};
   PlotSeries ct{"tensile cracks", {}, {}, "#d62728", false, true};
@@ -271,8 +271,9 @@ PlotDocuments plot_documents(const FrameTest& test, const LoadingFrame& f,
       std::string(test.name()) + " test: " + meta.value("material_name", std::string("specimen"));
   Snapshot final = frame_snapshot(f);
   add_fractures(final, f.cracks().cracks(), ev, INFINITY);
-  return {line_plot_svg(title, labels.x, labels.y, "cracks", series, crack_markers(test, f, r)),
-          crack_map_svg(final, title + ", cracks at the end", labels.map_axis)};
+  return {
+      line_plot_svg(title, labels.x, labels.y, "cracks", series, crack_markers(test, f, r)),
+      crack_map_svg(final, title + ", cracks at the end", labels.map_axis, f.geometry().diametral)};
 }
 
 void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::time_point t0) {

@@ -457,7 +457,11 @@ nlohmann::json tiny_calibration(const std::string& name, const std::vector<int>&
            {{{"name", "ucs"}, {"test", "ucs"}, {"output", {{"vtk", false}, {"plots", false}}}}}},
           {"seeds", seeds},
           {"budget",
-           {{"elastic", elastic}, {"strength", strength}, {"ratios", 0}, {"polish", polish}}}};
+           {{"elastic", elastic},
+            {"strength", strength},
+            {"ratios", 0},
+            {"polish", polish},
+            {"validation_max", 6}}}};
 }
 
 TEST(CalibrationCli, ATestThatRejectsItsInputStopsTheCampaignWithTwo) {
@@ -517,12 +521,19 @@ TEST(CalibrationCli, TinyCalibrationMeetsItsTargetsAndResumesFromItsCache) {
   const int done = evaluations();
   ASSERT_GE(done, 1);
   EXPECT_FALSE(fs::exists(dir / "out" / "card.json"));
-  // Resume: the cached evaluations are reused, the targets met.
+  // Resume: the cached evaluations are reused, the targets met on the tuned seed. The exit status
+  // follows the validation on fresh seeds (one tuned seed of this tiny specimen does not hold on
+  // the next ones: its UCS scatters by tens of %).
+  const std::string cmd =
+      rocklab::test::binary() + " calibrate " + file + " -o " + out + " --jobs 1";
+  auto finished = [](int status, const std::string& said) {
+    return (status == 0 &&
+            said.find("validation   every target met on 6 fresh seeds") != std::string::npos) ||
+           (status == 1 &&
+            said.find("validation   NOT every target met on 6 fresh seeds") != std::string::npos);
+  };
   std::string msg;
-  ASSERT_EQ(rocklab::test::run_command(
-                rocklab::test::binary() + " calibrate " + file + " -o " + out + " --jobs 1", &msg),
-            0)
-      << msg;
+  ASSERT_TRUE(finished(rocklab::test::run_command(cmd, &msg), msg)) << msg;
   std::smatch m;
   ASSERT_TRUE(std::regex_search(msg, m, std::regex(R"(\((\d+) suites run, (\d+) cached\))")))
       << msg;
@@ -546,13 +557,23 @@ TEST(CalibrationCli, TinyCalibrationMeetsItsTargetsAndResumesFromItsCache) {
       report, row, std::regex(R"(\| flatjoint\.fj_ten \| \+10 % \| (\S+) \| (\S+) \|)")))
       << report;
   EXPECT_LT(std::abs(std::stod(row[2])), 0.05) << report;
+  // The validation on 6 fresh seeds, and what the noise leaves of each parameter: the modulus is
+  // pinned by E, the cohesion moves no target (every joint breaks in tension).
+  EXPECT_NE(report.find("## Validation on fresh seeds"), std::string::npos) << report;
+  EXPECT_TRUE(std::regex_search(
+      report, std::regex(R"(\| ucs_Pa \| 2e\+07 \| 5 % \| \S+ ± nan \| \S+ ± \S+ \| [-+]\d)")))
+      << report;
+  EXPECT_NE(report.find("(1001, 1002, 1003, 1004, 1005, 1006)"), std::string::npos) << report;
+  EXPECT_TRUE(
+      std::regex_search(report, std::regex(R"(\| flatjoint\.fj_emod \| \S+ \| \S+ % \| yes \|)")))
+      << report;
+  EXPECT_TRUE(
+      std::regex_search(report, std::regex(R"(\| flatjoint\.fj_coh \| \S+ \| — \| \*\*no\*\*)")))
+      << report;
   const std::string svg = rocklab::test::read_file(dir / "out" / "convergence.svg");
   EXPECT_NE(svg.find("<polyline"), std::string::npos);
   // The fitted card is a valid material card, and a rerun runs nothing and writes the same card.
-  ASSERT_EQ(rocklab::test::run_command(
-                rocklab::test::binary() + " calibrate " + file + " -o " + out + " --jobs 1", &msg),
-            0)
-      << msg;
+  ASSERT_TRUE(finished(rocklab::test::run_command(cmd, &msg), msg)) << msg;
   EXPECT_NE(msg.find("(0 suites run"), std::string::npos) << msg;
   EXPECT_EQ(nlohmann::json::parse(rocklab::test::read_file(dir / "out" / "card.json")), card);
   // A replicate whose test rejected its input (exit 2: it stopped the campaign, e.g. a packing
@@ -564,10 +585,7 @@ TEST(CalibrationCli, TinyCalibrationMeetsItsTargetsAndResumesFromItsCache) {
   sm["tests"][0]["exit_status"] = 2;
   sm["tests"][0]["error"] = "rocklab: input error: an old rejection";
   std::ofstream(first / "suite" / "summary.json") << sm.dump(2);
-  ASSERT_EQ(rocklab::test::run_command(
-                rocklab::test::binary() + " calibrate " + file + " -o " + out + " --jobs 1", &msg),
-            0)
-      << msg;
+  ASSERT_TRUE(finished(rocklab::test::run_command(cmd, &msg), msg)) << msg;
   EXPECT_NE(msg.find("(1 suites run"), std::string::npos) << msg;
   EXPECT_EQ(nlohmann::json::parse(rocklab::test::read_file(dir / "out" / "card.json")), card);
   ASSERT_EQ(rocklab::test::run_command(rocklab::test::binary() + " genesis " + out +

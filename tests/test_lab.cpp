@@ -788,6 +788,13 @@ TEST(Lab, EnvelopeFitRecoversMohrCoulombAndHoekBrown) {
   ASSERT_TRUE(e.has_hb);
   EXPECT_TRUE(test::near_rel(e.hb_mi, mi, 1e-9));
   EXPECT_TRUE(test::near_rel(e.hb_sigma_c, sc, 1e-9));
+  EXPECT_LT(e.hb_fit_error, 1e-9); // exact points
+  EXPECT_DOUBLE_EQ(e.sigma3_max, 10e6);
+  // A point 5 % off the curve: the fit error is the rms relative misfit of sigma1, a few %.
+  s1[2] *= 1.05;
+  e = fit_envelope(s3, s1);
+  EXPECT_GT(e.hb_fit_error, 0.005);
+  EXPECT_LT(e.hb_fit_error, 0.05);
   EXPECT_FALSE(fit_envelope({0, 2e6}, {1e8, 1.1e8}).has_hb); // two points: no Hoek-Brown
 }
 

@@ -24,7 +24,9 @@ With --section, instead: the cells of the grains whose centres lie behind the pl
 axis facing the camera (whole grains, so the cut shows their faces), coloured by the non-affine
 strain since loading began [-] (viz/nonaffine.hpp): intact rock dark, however strained, and the
 fracture zone bright where grains moved apart or slid past their neighbours.
-The camera frames the specimen (not the platens, which are metres wide).
+The camera frames the specimen (not the platens, which are metres wide); a Brazilian disk is seen
+face-on (its axis towards the camera, the loaded diameter vertical), so the split runs up the
+picture between the platens.
 """
 import json
 import math
@@ -269,6 +271,7 @@ def main(argv):
         with open(os.path.join(o["out"], "results.json")) as f:
             results = json.load(f)
     dim = results.get("specimen", {}).get("dimension", 3)
+    disk = results.get("test") == "brazilian"
 
     view = GetActiveViewOrCreate("RenderView")
     view.ViewSize = list(o["size"])
@@ -322,15 +325,19 @@ def main(argv):
         f = frame_fields(cells or grains, t)
         name = results.get("test", "test")
         material = results.get("provenance", {}).get("material", "")
-        caption.Text = ("%s test  %s  (loading axis vertical)\n"
-                        "axial strain %.3f %%   axial stress %.1f MPa   step %d%s") % (
-            name.upper(), material, 100 * f.get("axial_strain", 0.0),
+        caption.Text = ("%s test  %s  (%s)\n"
+                        "%s %.3f %%   %s %.1f MPa   step %d%s") % (
+            name.upper(), material,
+            "disk face-on, loaded diameter vertical" if disk else "loading axis vertical",
+            "platen displacement / D" if disk else "axial strain",
+            100 * f.get("axial_strain", 0.0), "2F/(pi D t)" if disk else "axial stress",
             1e-6 * f.get("axial_stress", 0.0), int(f.get("step", 0)),
             "\nsection through the axis (azimuth %g deg): the grains behind it" % o["azimuth"]
             if section and dim == 3 else "")
-        frame_specimen(view, cells or grains, t, 2 if section else dim,
-                       facing=tuple(-c for c in section_view(o["azimuth"])) if section and dim == 3
-                       else (0, 0, 1))
+        # A Brazilian disk (axis z, loaded along y) is seen face-on: its split runs up the picture.
+        frame_specimen(view, cells or grains, t, 2 if section or disk else dim,
+                       facing=tuple(-c for c in section_view(o["azimuth"]))
+                       if section and dim == 3 and not disk else (0, 0, 1))
         Render(view)
 
     if o["frames"]:

@@ -34,7 +34,10 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
 
 /// The cracks of a snapshot over its grains: 2D as it is; 3D a central section seen along
 /// `depth_axis` (1: y, x right and z up; 2: z, x right and y up — a Brazilian disk's faces),
-/// each crack drawn as its trace. Red: tension, blue: shear.
-std::string crack_map_svg(const Snapshot& s, const std::string& title, int depth_axis = 1);
+/// each crack drawn as its trace. Red: tension, blue: shear. `disk`: a Brazilian disk loaded
+/// along the picture's vertical: every crack through its thickness (projected onto the face, over
+/// the mid-section's grains), the loaded diameter dashed and the platens' contact points marked.
+std::string crack_map_svg(const Snapshot& s, const std::string& title, int depth_axis = 1,
+                          bool disk = false);
 
 } // namespace rocklab

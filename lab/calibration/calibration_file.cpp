@@ -253,6 +253,20 @@ CalibrationFile load_calibration(const std::string& path) {
   c.budget.ratios = static_cast<int>(b.integer("ratios", 0, 1000, c.budget.ratios));
   c.budget.polish = static_cast<int>(b.integer("polish", 0, 100, c.budget.polish));
   c.budget.sensitivity = b.boolean("sensitivity", c.budget.sensitivity);
+  c.budget.max_seeds = static_cast<int>(b.integer("max_seeds", 0, 100, 0));
+  if (c.budget.max_seeds > 0 && c.budget.max_seeds < static_cast<int>(c.seeds.size()))
+    b.fail("max_seeds", "must be 0 (automatic) or at least the " + std::to_string(c.seeds.size()) +
+                            " seeds listed in \"seeds\"");
+  c.budget.validation_min =
+      static_cast<int>(b.integer("validation_min", 2, 1000, c.budget.validation_min));
+  c.budget.validation_max =
+      static_cast<int>(b.integer("validation_max", 0, 1000, c.budget.validation_max));
+  if (c.budget.validation_max > 0 && c.budget.validation_max < c.budget.validation_min)
+    b.fail("validation_max", "must be 0 (no validation) or at least budget.validation_min (" +
+                                 std::to_string(c.budget.validation_min) + ")");
+  c.budget.validation_first =
+      static_cast<std::uint64_t>(b.integer("validation_first", 0, std::int64_t{1} << 50,
+                                           static_cast<std::int64_t>(c.budget.validation_first)));
   b.finish();
   top.finish();
   return c;

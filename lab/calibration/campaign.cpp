@@ -1,6 +1,7 @@
 #include "lab/calibration/campaign.hpp"
 
 #include "io/output_dir.hpp"
+#include "lab/calibration/noise.hpp"
 #include "lab/calibration/report.hpp"
 #include "viz/svg_png.hpp"
 
@@ -43,7 +44,7 @@ Sensitivity sensitivity(Evaluator& ev, const CalibrationFile& c, const std::vect
 }
 
 // One line per evaluation: each measured target and its error in tolerances, the worst, the time.
-void print_progress(int n, Stage s, const CalibrationFile& c, const Evaluation& e,
+void print_progress(const std::string& what, const CalibrationFile& c, const Evaluation& e,
                     std::chrono::steady_clock::duration took) {
   std::string line;
   double worst = 0;
@@ -60,13 +61,42 @@ void print_progress(int n, Stage s, const CalibrationFile& c, const Evaluation& 
   char tail[64] = "", cpu[48] = "";
   if (unmeasured > 0)
     std::snprintf(tail, sizeof tail, " (%d target(s) not measured)", unmeasured);
+  if (e.rejected_disks > 0) {
+    char r[96];
+    std::snprintf(r, sizeof r, "; %d Brazilian disk(s) not valid (fracture at a platen) left out",
+                  e.rejected_disks);
+    line += r;
+  }
   if (e.cpu_utilisation >= 0)
     std::snprintf(cpu, sizeof cpu, ", CPU %.0f %% of %d cores", 100 * e.cpu_utilisation, e.cores);
   std::fprintf(stderr,
-               "[rocklab calibrate] %d %s:%s; worst %.2f tolerances%s; %zu seed(s), %d cached, "
+               "[rocklab calibrate] %s:%s; worst %.2f tolerances%s; %zu seed(s), %d cached, "
                "%.0f s%s\n",
-               n, stage_name(s), line.c_str(), worst, tail, e.folders.size(), e.cached,
+               what.c_str(), line.c_str(), worst, tail, e.folders.size(), e.cached,
                std::chrono::duration<double>(took).count(), cpu);
+}
+
+// The fitted card on fresh seeds it was never tuned on: as many as make each target's standard
+// error half its tolerance (from the tuned seeds' scatter), within the budget's bounds.
+void validate(Evaluator& ev, const CalibrationFile& c, const std::vector<double>& values,
+              ReportInput& r, bool talk) {
+  Measured sd = r.sd; // one tuned seed: its scatter is not known
+  if (r.seeds < 2)
+    for (auto& [k, v] : sd)
+      v = std::nan("");
+  const int n =
+      validation_seed_count(c.targets, sd, c.budget.validation_min, c.budget.validation_max);
+  r.validation_seeds = fresh_seeds(c.budget.validation_first, n, ev.seeds());
+  if (talk)
+    std::fprintf(stderr, "[rocklab calibrate] validation: the fitted card on %d fresh seeds\n", n);
+  const auto t = std::chrono::steady_clock::now();
+  const Evaluation v = ev.run_on(values, Stage::Final, r.validation_seeds);
+  if (talk)
+    print_progress("validation", c, v, std::chrono::steady_clock::now() - t);
+  r.validation_rejected = v.rejected_disks;
+  r.validation_mean = v.mean;
+  r.validation_sd = v.sd;
+  r.validation_se = v.se;
 }
 
 } // namespace
@@ -87,28 +117,51 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
     params.push_back(p.param);
   Evaluation last;
   int count = 0;
+  const bool talk = o.progress && (!o.ranks || o.ranks->root());
   const Evaluate evaluate = [&](const std::vector<double>& v, Stage s) {
     const auto t = std::chrono::steady_clock::now();
     last = ev.run(v, s);
-    if (o.progress && (!o.ranks || o.ranks->root()))
-      print_progress(++count, s, c, last, std::chrono::steady_clock::now() - t);
-    return last.mean;
+    if (talk)
+      print_progress(std::to_string(++count) + " " + stage_name(s), c, last,
+                     std::chrono::steady_clock::now() - t);
+    Measured m = last.mean;
+    for (const auto& [k, se] : last.se)
+      m[se_key(k)] = se;
+    return m;
+  };
+  // Where a steered target's miss is within its noise, a seed more (up to the budget's).
+  const int max_seeds =
+      c.budget.max_seeds > 0 ? c.budget.max_seeds : std::max(static_cast<int>(c.seeds.size()), 6);
+  const AddSeed add_seed = [&] {
+    const bool added = ev.add_seed(max_seeds);
+    if (added && talk)
+      std::fprintf(stderr, "[rocklab calibrate] a miss within the noise: seed %llu added\n",
+                   static_cast<unsigned long long>(ev.seeds().back()));
+    return added;
   };
   CampaignSummary cs;
-  cs.outcome = calibrate(params, c.targets, evaluate, c.budget);
-  if (o.progress && (!o.ranks || o.ranks->root()))
+  cs.outcome = calibrate(params, c.targets, evaluate, c.budget, add_seed);
+  if (talk)
     for (const std::string& n : cs.outcome.notes)
       std::fprintf(stderr, "[rocklab calibrate] note: %s\n", n.c_str());
   ReportInput r;
   r.file = &c;
   r.outcome = &cs.outcome;
   r.sd = last.sd;
+  r.se = last.se;
+  r.rejected = last.rejected_disks;
+  r.seeds = static_cast<int>(last.folders.size());
   r.final_folders = last.folders;
   std::vector<double> values;
   for (const Param& p : cs.outcome.params)
     values.push_back(p.value);
+  if (c.budget.validation_max > 0) {
+    validate(ev, c, values, r, talk);
+    cs.validation_seeds = static_cast<int>(r.validation_seeds.size());
+    cs.validation_met = every_target_met(c.targets, r.validation_mean);
+  }
   if (c.budget.sensitivity) {
-    if (o.progress && (!o.ranks || o.ranks->root()))
+    if (talk)
       std::fprintf(stderr,
                    "[rocklab calibrate] sensitivity: %zu single-seed runs, one per "
                    "parameter\n",
@@ -125,9 +178,12 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   if (o.ranks && !o.ranks->root())
     return cs; // rank 0 writes the outputs
   nlohmann::json card = apply_params(c.material, c.params, values);
+  std::string verdict = cs.outcome.met ? "every target met" : "not every target met";
+  if (cs.validation_seeds > 0)
+    verdict += std::string(cs.validation_met ? ", and" : ", not every one") + " on " +
+               std::to_string(cs.validation_seeds) + " fresh validation seeds";
   card["source"] = "Calibrated by rocklab calibrate " + fs::path(file).filename().string() +
-                   " from " + fs::path(c.material_file).filename().string() + " (" +
-                   (cs.outcome.met ? "every target met" : "not every target met") +
+                   " from " + fs::path(c.material_file).filename().string() + " (" + verdict +
                    "; see report.md).";
   const fs::path out(o.out_dir);
   write_text_file(out / "card.json", card.dump(2) + "\n");
@@ -135,6 +191,33 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   write_svg_and_png(out / "convergence.svg", convergence_svg(c, cs.outcome));
   write_text_file(out / "report.md", report_md(r));
   return cs;
+}
+
+std::string run_pilot(const std::string& file, const EvaluatorOptions& o) {
+  const CalibrationFile c = load_calibration(file);
+  fs::create_directories(o.out_dir);
+  Evaluator ev(c, o);
+  std::vector<double> start;
+  for (const CardParam& p : c.params)
+    start.push_back(p.param.value);
+  const Evaluation e = ev.run(start, Stage::Final);
+  std::string s;
+  char b[256];
+  std::snprintf(b, sizeof b, "pilot        the start card on %zu seed(s), every test\n",
+                e.folders.size());
+  s += b;
+  for (const Target& t : c.targets) {
+    const double sd = value_of(e.sd, t.property);
+    const int need = seeds_needed(t, e.folders.size() > 1 ? sd : std::nan(""));
+    std::snprintf(b, sizeof b, "seeds        %-26s mean %.4g, sd %.3g, standard error %.3g; %s\n",
+                  t.property.c_str(), value_of(e.mean, t.property), sd, value_of(e.se, t.property),
+                  need < 0 ? "one seed cannot tell its scatter: give 2 or more"
+                           : ("needs " + std::to_string(need) +
+                              " seed(s) for a standard error of half its tolerance")
+                                 .c_str());
+    s += b;
+  }
+  return s;
 }
 
 } // namespace rocklab::calibration

@@ -1,4 +1,5 @@
 #include "lab/calibration/evaluator.hpp"
+#include "lab/calibration/noise.hpp"
 
 #include "io/input_error.hpp"
 #include "io/json_input.hpp"
@@ -108,6 +109,17 @@ void Evaluator::check_tests(const nlohmann::json& summary, const fs::path& suite
 }
 
 namespace {
+// A property measured on (or over) the Brazilian disk, other than its validity.
+bool reads_the_disk(const std::string& property) {
+  if (property == "brazilian_valid")
+    return false;
+  for (const TargetNeed& n : target_needs())
+    if (n.property == property &&
+        (std::string(n.test) == "brazilian" || (n.other && std::string(n.other) == "brazilian")))
+      return true;
+  return false;
+}
+
 // A finished replicate is reused unless one of its tests rejected its input (exit status 2). That
 // rejection stopped the campaign; once its cause is fixed (in the file, or in rocklab: a 3D packing
 // cache that could not be read back) a resumed campaign runs the replicate again instead of
@@ -128,7 +140,21 @@ bool reusable(const fs::path& suite_out) {
 }
 } // namespace
 
+bool Evaluator::add_seed(int max_seeds) {
+  if (static_cast<int>(seeds_.size()) >= max_seeds)
+    return false;
+  seeds_.push_back(*std::max_element(seeds_.begin(), seeds_.end()) + 1);
+  return true;
+}
+
 Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_t seeds) {
+  const std::vector<std::uint64_t> first(
+      seeds_.begin(), seeds_.begin() + static_cast<std::ptrdiff_t>(std::min(seeds, seeds_.size())));
+  return run_on(values, s, first);
+}
+
+Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
+                             const std::vector<std::uint64_t>& seeds) {
   const nlohmann::json card = apply_params(c_.material, c_.params, values);
   const nlohmann::json stage_tests = tests_of(s);
   // The cache key: everything the result depends on, with the revision of each test's measurement
@@ -141,9 +167,7 @@ Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_
       revisions += " r" + std::to_string(p->revision());
     }
   std::vector<Replicate> reps;
-  for (std::uint64_t seed : c_.seeds) {
-    if (reps.size() >= seeds)
-      break;
+  for (std::uint64_t seed : seeds) {
     nlohmann::json ts = stage_tests;
     for (auto& t : ts)
       t["seed"] = seed;
@@ -193,12 +217,18 @@ Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_
     ev.folders.push_back(suite_out.string());
     const nlohmann::json sm = read_json_file((suite_out / "summary.json").string(), Nulls::Allow);
     check_tests(sm, suite_out, reps[i].tests);
-    for (const auto& [k, v] : sm["properties"].items())
-      all[k].push_back(v.is_number() ? v.get<double>() : std::nan(""));
+    const nlohmann::json& props = sm["properties"];
+    const bool rejected = props.contains("brazilian_valid") &&
+                          props["brazilian_valid"].is_number() &&
+                          props["brazilian_valid"].get<double>() == 0;
+    ev.rejected_disks += rejected ? 1 : 0;
+    for (const auto& [k, v] : props.items())
+      all[k].push_back(v.is_number() && !(rejected && reads_the_disk(k)) ? v.get<double>()
+                                                                         : std::nan(""));
   }
   cached_ += ev.cached;
   for (const std::string& k : average_replicates(all, ev))
-    if (!o_.ranks || o_.ranks->rank() == 0)
+    if ((!o_.ranks || o_.ranks->rank() == 0) && !(ev.rejected_disks > 0 && reads_the_disk(k)))
       std::fprintf(stderr,
                    "[rocklab calibrate] warning: %s was not measured on every seed; the mean is "
                    "over those that measured it\n",
@@ -224,6 +254,8 @@ std::vector<std::string> average_replicates(const std::map<std::string, std::vec
       q += (x - m) * (x - m);
     ev.mean[k] = m;
     ev.sd[k] = v.size() > 1 ? std::sqrt(q / static_cast<double>(v.size() - 1)) : 0.0;
+    ev.n[k] = static_cast<int>(v.size());
+    ev.se[k] = standard_error(ev.sd[k], ev.n[k]);
     if (!v.empty() && v.size() < all_v.size())
       partial.push_back(k);
   }

@@ -23,12 +23,17 @@ struct EvaluatorOptions {
   bool progress = false;        ///< one line per evaluation on stderr (rank 0)
 };
 
-/// Properties of one evaluation: the mean over the seeds and the sample standard deviation
-/// (0 for one seed), by property name.
+/// Properties of one evaluation: the mean over the seeds, the sample standard deviation (0 for
+/// one seed), the standard error of the mean (NaN for one seed) and the seeds that measured it,
+/// by property name.
 struct Evaluation {
-  Measured mean, sd;
+  Measured mean, sd, se;
+  std::map<std::string, int> n;
   std::vector<std::string> folders; ///< the suites' output folders, one per seed
-  int cached = 0;                   ///< seeds found in the cache
+  /// Brazilian disks not valid (their fracture started at a platen, ISRM): the properties that
+  /// read the disk (bts_Pa, ucs_over_bts, ...) leave those seeds out of their means.
+  int rejected_disks = 0;
+  int cached = 0; ///< seeds found in the cache
   /// CPU time of the test processes this rank ran for it over (wall time x cores), [0, 1];
   /// -1 when every seed came from the cache.
   double cpu_utilisation = -1;
@@ -38,9 +43,9 @@ struct Evaluation {
 /// CPU seconds of the finished child processes (the tests) of this process.
 double children_cpu_seconds();
 
-/// Adds to `ev` the mean and sample standard deviation of each property over the seeds that
-/// measured it (non-finite values are left out; NaN when none did); returns the properties some
-/// seeds did not measure.
+/// Adds to `ev` the mean, sample standard deviation, standard error and count of each property
+/// over the seeds that measured it (non-finite values are left out; NaN when none did); returns
+/// the properties some seeds did not measure.
 std::vector<std::string> average_replicates(const std::map<std::string, std::vector<double>>& all,
                                             Evaluation& ev);
 
@@ -51,6 +56,14 @@ public:
   nlohmann::json tests_of(Stage s) const;
   /// Runs (or finds in the cache) the tests of stage `s` on the first `seeds` replicate seeds.
   Evaluation run(const std::vector<double>& values, Stage s, std::size_t seeds = SIZE_MAX);
+  /// The same on the given seeds (the validation's fresh seeds).
+  Evaluation run_on(const std::vector<double>& values, Stage s,
+                    const std::vector<std::uint64_t>& seeds);
+  /// The replicate seeds of every evaluation from now on: the file's, and those added.
+  const std::vector<std::uint64_t>& seeds() const { return seeds_; }
+  /// One more replicate seed (the next integer after the largest used), while fewer than
+  /// `max_seeds`; false when there are that many already.
+  bool add_seed(int max_seeds);
   int suites_run() const { return run_; }
   int suites_cached() const { return cached_; }
 
@@ -67,6 +80,7 @@ private:
 
   const CalibrationFile& c_;
   EvaluatorOptions o_;
+  std::vector<std::uint64_t> seeds_ = c_.seeds;
   int run_ = 0, cached_ = 0;
 };
 

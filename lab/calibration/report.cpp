@@ -1,6 +1,7 @@
 #include "lab/calibration/report.hpp"
 
 #include "io/results.hpp"
+#include "lab/calibration/noise.hpp"
 #include "viz/svg_plots.hpp"
 
 #include <algorithm>
@@ -67,14 +68,97 @@ std::string sensitivity_table(const ReportInput& r) {
       s.append(" ").append(fmt(d, "%.2f")).append(" |");
     s += "\n";
   }
-  // What the packing alone does: the seed-to-seed spread relative to the mean, per unit step.
+  // What the packing alone does: the seed-to-seed spread relative to the mean, per unit step
+  // (over the validation seeds where there are any: one tuned seed has no spread).
+  const bool val = !r.validation_seeds.empty();
   s += "| *seed-to-seed sd / mean ÷ 10 %* | |";
   for (const Target& t : c.targets) {
-    const double m = value_of(r.outcome->measured, t.property), sd = value_of(r.sd, t.property);
+    const double m = value_of(val ? r.validation_mean : r.outcome->measured, t.property),
+                 sd = value_of(val ? r.validation_sd : r.sd, t.property);
     s.append(" *").append(fmt(std::abs(sd / m) / 0.1, "%.2f")).append("* |");
   }
   return s + "\n\nAn entry smaller than the last row's can be the packing's noise: a different "
              "packing changes the property by that much at the same parameters.\n";
+}
+
+// Each target on the tuned seeds and on the fresh validation seeds, with its standard error.
+std::string validation_table(const ReportInput& r) {
+  const CalibrationFile& c = *r.file;
+  const std::size_t nv = r.validation_seeds.size();
+  if (nv == 0)
+    return "No validation on fresh seeds (`\"budget\": {\"validation_max\": 0}`).\n";
+  std::string seeds;
+  for (std::size_t i = 0; i < nv; ++i)
+    seeds += (i ? ", " : "") + std::to_string(r.validation_seeds[i]);
+  std::string s = "The fitted card on " + std::to_string(nv) +
+                  " fresh seeds it was never tuned on (" + seeds +
+                  "): each mean ± its standard error (sd / √seeds). A target is *met* when the "
+                  "validation mean is within its tolerance; where its standard error exceeds half "
+                  "the tolerance the last column gives the seeds it needs.\n\n"
+                  "| target | value | tolerance | tuned (" +
+                  std::to_string(r.seeds) + (r.seeds == 1 ? " seed" : " seeds") +
+                  ") | validation (" + std::to_string(nv) +
+                  " seeds) | error / tolerance | met | seeds for SE ≤ ½ tolerance |\n"
+                  "|---|---|---|---|---|---|---|---|\n";
+  for (const Target& t : c.targets) {
+    const double m = value_of(r.validation_mean, t.property);
+    const double se = value_of(r.validation_se, t.property);
+    const int need = seeds_needed(t, value_of(r.validation_sd, t.property));
+    s += "| " + t.property + " | " + fmt(t.value) + " | " +
+         (t.absolute ? "± " + fmt(t.tolerance) : fmt(100 * t.tolerance) + " %") + " | " +
+         fmt(value_of(r.outcome->measured, t.property)) + " ± " + fmt(value_of(r.se, t.property)) +
+         " | " + fmt(m) + " ± " + fmt(se) + " | " + fmt(t.error(m), "%+.2f") + " | " +
+         (std::abs(t.error(m)) <= 1 ? "yes" : "**no**") + " | ";
+    s += need < 0
+             ? "?"
+             : std::to_string(need) + (se > 0.5 * tolerance_in_units(t) ? " (more than run)" : "");
+    s += " |\n";
+  }
+  if (r.rejected + r.validation_rejected > 0)
+    s += "\nBrazilian disks left out of the means (their fracture started at a platen: not valid, "
+         "ISRM): " +
+         std::to_string(r.rejected) + " of " + std::to_string(r.seeds) + " tuned, " +
+         std::to_string(r.validation_rejected) + " of " + std::to_string(nv) +
+         " validation seeds.\n";
+  return s;
+}
+
+// What the seed noise leaves of each fitted parameter (noise.hpp): from the sensitivity table and
+// the tuned means' relative standard errors (the seed sd measured on the validation seeds when
+// there are any: more seeds, a better estimate).
+std::string uncertainty_table(const ReportInput& r) {
+  const CalibrationFile& c = *r.file;
+  if (r.sensitivity.per.size() != c.params.size())
+    return "No parameter uncertainty (it needs the sensitivity table).\n";
+  const bool val = !r.validation_seeds.empty();
+  std::vector<double> rel;
+  for (const Target& t : c.targets) {
+    const double sd = value_of(val ? r.validation_sd : r.sd, t.property);
+    const double m = value_of(val ? r.validation_mean : r.outcome->measured, t.property);
+    rel.push_back(sd / std::sqrt(std::max(r.seeds, 1)) / std::abs(m));
+  }
+  const std::vector<ParamUncertainty> u = parameter_uncertainty(r.sensitivity.per, rel);
+  std::string s =
+      "What the packings' noise leaves of the fitted parameters: the linearised least-squares "
+      "uncertainty from the sensitivity table and each target's relative standard error over "
+      "the " +
+      std::to_string(r.seeds) + " tuned seed(s) (the seed-to-seed sd " +
+      (val ? "of the validation seeds" : "of the tuned seeds") +
+      "). *Not identifiable*: the targets given cannot pin it — it can trade with other "
+      "parameters, or move by more than ±50 % (1 sd), without a target changing by more than its "
+      "noise; fix it from other data or add a target it moves.\n\n| parameter | final | ± 1 sd "
+      "| identifiable |\n|---|---|---|---|\n";
+  for (std::size_t i = 0; i < c.params.size(); ++i) {
+    s += "| " + c.params[i].key + " | " + fmt(r.outcome->params[i].value) + " | ";
+    s += std::isfinite(u[i].sd_ln) ? fmt(100 * std::expm1(u[i].sd_ln), "%.1f") + " %" : "—";
+    s += u[i].identifiable ? " | yes |\n"
+         : u[i].blind_share >= 0.1
+             ? " | **no**: " + fmt(100 * u[i].blind_share, "%.0f") +
+                   " % of it lies where no target sees it (inert, or trading with other "
+                   "parameters) |\n"
+             : std::string(" | **no**: the noise leaves it uncertain by more than 50 % |\n");
+  }
+  return s;
 }
 
 } // namespace
@@ -149,10 +233,18 @@ std::string report_md(const ReportInput& r) {
   const CalibrationFile& c = *r.file;
   const Outcome& out = *r.outcome;
   std::string s = "# Calibration report: " + c.name + "\n\nUnits SI. Calibration file `" + c.file +
-                  "`, base card `" + c.material_file + "`; " + std::to_string(c.seeds.size()) +
-                  " replicate seed(s) per evaluation.\n\n";
-  s += std::string("**") + (out.met ? "Every target met." : "Not every target met.") + "**\n\n";
-  s += targets_table(r) + "\n" + params_table(r) + "\n" + sensitivity_table(r);
+                  "`, base card `" + c.material_file + "`; " + std::to_string(r.seeds) +
+                  " replicate seed(s) in the final evaluation.\n\n";
+  s += std::string("**") + (out.met ? "Every target met" : "Not every target met") +
+       " on the tuned seeds";
+  if (!r.validation_seeds.empty())
+    s += every_target_met(c.targets, r.validation_mean)
+             ? "; every target met on the fresh validation seeds."
+             : "; not every target met on the fresh validation seeds.";
+  s += "**\n\n";
+  s += targets_table(r) + "\n## Validation on fresh seeds\n\n" + validation_table(r) + "\n" +
+       params_table(r) + "\n" + sensitivity_table(r) + "\n## Parameter uncertainty\n\n" +
+       uncertainty_table(r);
   if (!out.notes.empty()) {
     s += "\n**Noticed on the way:**\n\n";
     for (const std::string& n : out.notes)

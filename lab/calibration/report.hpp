@@ -22,7 +22,13 @@ struct Sensitivity {
 struct ReportInput {
   const CalibrationFile* file = nullptr;
   const Outcome* outcome = nullptr;
-  Measured sd; ///< over the seeds, at the final evaluation
+  Measured sd;   ///< over the seeds, at the final evaluation
+  Measured se;   ///< standard error of the final evaluation's means (NaN: one seed)
+  int seeds = 0; ///< replicate seeds of the final evaluation
+  int rejected = 0, validation_rejected = 0; ///< Brazilian disks not valid (ISRM), left out
+  /// The fitted card on fresh seeds it was never tuned on (empty: no validation was run).
+  std::vector<std::uint64_t> validation_seeds;
+  Measured validation_mean, validation_sd, validation_se;
   Sensitivity sensitivity;
   std::vector<std::string> final_folders; ///< the final evaluation's suites, one per seed
   int suites_run = 0, suites_cached = 0;

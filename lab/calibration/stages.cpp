@@ -1,4 +1,5 @@
 #include "lab/calibration/stages.hpp"
+#include "lab/calibration/noise.hpp"
 
 #include <nlopt.hpp>
 
@@ -19,6 +20,12 @@ double Target::error(double measured) const {
 double value_of(const Measured& m, const std::string& key) {
   const auto it = m.find(key);
   return it == m.end() ? std::nan("") : it->second;
+}
+
+bool every_target_met(const std::vector<Target>& targets, const Measured& m) {
+  return std::all_of(targets.begin(), targets.end(), [&](const Target& t) {
+    return std::abs(t.error(value_of(m, t.property))) <= 1;
+  });
 }
 
 const char* stage_name(Stage s) {
@@ -117,8 +124,11 @@ struct Campaign {
   std::vector<Param>& p;
   const std::vector<Target>& targets;
   const Evaluate& evaluate;
+  const AddSeed& add_seed;
   Outcome& out;
-  int since_full = 0; ///< evaluations since the last one that measured everything
+  int since_full = 0;               ///< evaluations since the last one that measured everything
+  bool reseed = false;              ///< a seed was added: the same point is measured again
+  std::vector<const Target*> noisy; ///< targets whose noise the notes name
 
   const Target* target(const char* name) const {
     for (const Target& t : targets)
@@ -135,12 +145,13 @@ struct Campaign {
       v.push_back(x.value);
     // The same point again (a stage ending where the next begins): the last measurement serves
     // when its tests cover this stage's (Elastic and Strength run the same tests).
-    if (!out.history.empty() && out.history.back().values == v) {
+    if (!reseed && !out.history.empty() && out.history.back().values == v) {
       const Stage last = out.history.back().stage;
       const bool full = last == Stage::Ratios || last == Stage::Final;
       if (full || (s == Stage::Elastic || s == Stage::Strength))
         return out.history.back().measured;
     }
+    reseed = false;
     Measured m = evaluate(v, s);
     out.history.push_back({static_cast<int>(out.history.size()) + 1, s, v, m});
     out.measured = m;
@@ -155,6 +166,28 @@ struct Campaign {
   }
   bool met(const Target* t, const Measured& m) const {
     return !t || std::abs(t->error(value_of(m, t->property))) <= 1;
+  }
+  /// A miss of `t` smaller than twice its standard error: no step on it. True when a seed was
+  /// added (measure the same point again); false with a note when the budget allows no more.
+  bool hidden_by_noise(const Target* t, const Measured& m, bool& step) {
+    step = true;
+    const double v = value_of(m, t->property), se = value_of(m, se_key(t->property));
+    if (!within_noise(*t, v, se))
+      return false;
+    step = false;
+    if (add_seed && add_seed()) {
+      reseed = true;
+      return true;
+    }
+    if (std::find(noisy.begin(), noisy.end(), t) != noisy.end())
+      return false; // said already
+    noisy.push_back(t);
+    out.notes.push_back(t->property + " " + num(v) + " misses " + num(t->value) + " by " +
+                        num(t->error(v)) + " tolerances, within twice its standard error (" +
+                        num(se) +
+                        "): more seeds than the budget's are needed to tell; not "
+                        "stepped on");
+    return false;
   }
 
   void elastic(int budget);
@@ -181,7 +214,12 @@ void Campaign::elastic(int budget) {
     const bool ok_e = !steer_e || met(tE, m), ok_n = !steer_n || met(tn, m);
     if (ok_e && ok_n)
       return;
-    if (steer_n && !ok_n) {
+    bool step_e = false, step_n = false;
+    if ((!ok_e && hidden_by_noise(tE, m, step_e)) || (!ok_n && hidden_by_noise(tn, m, step_n)))
+      continue; // one more seed: the same point again
+    if (!step_e && !step_n)
+      return;
+    if (step_n) {
       const auto k = std::find_if(p.begin(), p.end(),
                                   [](const Param& x) { return x.role == Role::StiffnessRatio; });
       const double nu = value_of(m, kPoisson), lk = std::log(k->value);
@@ -197,7 +235,7 @@ void Campaign::elastic(int budget) {
       scale(Role::StiffnessRatio, std::exp(step));
     }
     const double e = value_of(m, kYoungs);
-    if (steer_e && e > 0)
+    if (step_e && e > 0)
       scale(Role::Modulus, std::clamp(tE->value / e, 0.25, 4.0));
   }
 }
@@ -211,6 +249,11 @@ void Campaign::strength(int budget) {
     const Measured m = run(Stage::Strength);
     const double u = value_of(m, kUcs);
     if (met(tu, m) || !(u > 0))
+      return;
+    bool step = false;
+    if (hidden_by_noise(tu, m, step))
+      continue;
+    if (!step)
       return;
     scale(Role::Strength, std::clamp(tu->value / u, 0.25, 4.0));
   }
@@ -336,9 +379,9 @@ void Campaign::ratios(int budget) {
 } // namespace
 
 Outcome calibrate(std::vector<Param> params, const std::vector<Target>& targets,
-                  const Evaluate& evaluate, const Budget& budget) {
+                  const Evaluate& evaluate, const Budget& budget, const AddSeed& add_seed) {
   Outcome out;
-  Campaign c{params, targets, evaluate, out};
+  Campaign c{params, targets, evaluate, add_seed, out, 0, false, {}};
   c.elastic(budget.elastic);
   c.strength(budget.strength);
   c.ratios(budget.ratios);
@@ -348,9 +391,7 @@ Outcome calibrate(std::vector<Param> params, const std::vector<Target>& targets,
   if (c.since_full > 0 || out.history.empty())
     c.run(Stage::Final);
   out.params = params;
-  out.met = std::all_of(targets.begin(), targets.end(), [&](const Target& t) {
-    return std::abs(t.error(value_of(out.measured, t.property))) <= 1;
-  });
+  out.met = every_target_met(targets, out.measured);
   return out;
 }
 

@@ -10,6 +10,7 @@
 // the properties: SI; the parameters are the card's own.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <string>
@@ -53,8 +54,17 @@ enum class Stage { Elastic, Strength, Ratios, Final };
 using Measured = std::map<std::string, double>;
 /// A measured property, NaN when the evaluation did not measure it.
 double value_of(const Measured& m, const std::string& key);
+/// Every target within its tolerance in `m`.
+bool every_target_met(const std::vector<Target>& targets, const Measured& m);
+/// Where Measured keeps the standard error of a property's mean over the seeds, beside the mean
+/// (absent or NaN: one seed, no estimate of the noise).
+inline std::string se_key(const std::string& property) {
+  return property + ".se";
+}
 /// Runs the tests a stage needs for these parameter values (in the order of the Param list).
 using Evaluate = std::function<Measured(const std::vector<double>& values, Stage stage)>;
+/// Adds a replicate seed to every later evaluation; false when the budget allows no more.
+using AddSeed = std::function<bool()>;
 
 struct Record {
   int evaluation = 0;
@@ -77,11 +87,20 @@ struct Outcome {
 /// defaults add up to at most 36 with the final evaluation.
 struct Budget {
   int elastic = 6, strength = 4, ratios = 20, polish = 3;
+  /// Replicate seeds per evaluation at most, the file's and those added where the noise
+  /// hides a miss (0: the file's seeds and at least 6)
+  int max_seeds = 0;
+  /// Validation seeds: at least `validation_min`, at most `validation_max` (0: no validation)
+  int validation_min = 6, validation_max = 12;
+  std::uint64_t validation_first = 1001; ///< fresh seeds from this one on
   bool sensitivity = true; ///< afterwards, one single-seed run per parameter (the report's table)
 };
 
+/// The stages. A steered target (E, nu, UCS) that misses by less than twice its standard error
+/// is not stepped on: the same point is evaluated again with one more seed from `add_seed` while
+/// that allows, and otherwise the stage leaves it and says so in the notes.
 Outcome calibrate(std::vector<Param> params, const std::vector<Target>& targets,
-                  const Evaluate& evaluate, const Budget& budget);
+                  const Evaluate& evaluate, const Budget& budget, const AddSeed& add_seed = {});
 
 /// Name of a stage or role (reports, errors).
 const char* stage_name(Stage s);

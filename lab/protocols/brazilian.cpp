@@ -96,8 +96,8 @@ class BrazilianTest final : public FrameTest {
 public:
   const char* name() const override { return "brazilian"; }
   // 2: strength before the split; 4: one bridge; 5: re-seating after a collapse without a split;
-  // 6: strength before the loss of the diametral tension
-  int revision() const override { return 6; }
+  // 6: strength before the loss of the diametral tension; 7: the fracture's origin (validity)
+  int revision() const override { return 7; }
   void read_options(JsonObject& loading, JsonObject& stop, const Protocol& p) override {
     if (loading.choice("jaws", {"flat", "curved"}, "flat") == "curved")
       jaw_ratio_ = loading.number("jaw_radius_ratio", Range::closed(1.1, 10), 1.5);
@@ -203,6 +203,9 @@ public:
     const std::int64_t until =
         split < 0 ? -1 : (lost >= 0 ? lost : std::numeric_limits<std::int64_t>::max());
     const LabSample best = strongest_before(f.samples(), peak, until);
+    record_origin(
+        split_origin(f.cracks().cracks(), f.geometry(), best.load > 0 ? best.step : peak.step),
+        best.load > 0, r);
     if (best.load <= 0) { // no split, or one before loading began (seating)
       r["tensile_strength_Pa"] = nullptr;
       r["peak_force_N"] = peak.force;
@@ -227,7 +230,8 @@ public:
     r["split"]["stress_Pa"] = best.load;
   }
   PlotLabels plot_labels() const override {
-    return {"platen displacement / D [%]", "2F / (pi D t) [MPa]", false, 2};
+    return {"platen displacement / D [%]", "2F / (pi D t) [MPa]", false, 2,
+            "2F/(pi D t) vs platen displacement / D"};
   }
   // The strength before the split released the diametral tension, and what the halves carried.
   void print_results(const nlohmann::json& r) const override {
@@ -252,11 +256,28 @@ public:
       more = b;
     }
     print_tensile_strength(r, more);
+    if (r.contains("fracture_origin")) {
+      const nlohmann::json& o = r["fracture_origin"];
+      std::printf("fracture     started %s (first cracks at %.2f of the radius, %.0f %% of the "
+                  "diametral cracks within D/6 of a platen): %s\n",
+                  o["site"] == "centre"     ? "in the centre"
+                  : o["site"] == "diameter" ? "along the diameter"
+                                            : "at a platen",
+                  json_number(o, "start_position", std::nan("")),
+                  100 * json_number(o, "platen_share", std::nan("")),
+                  o["valid"].get<bool>() ? "valid (ISRM)" : "NOT valid (ISRM: discard the disk)");
+    }
   }
-  std::vector<SuiteProperty> suite_properties() const override { return {{"bts_Pa"}}; }
+  std::vector<SuiteProperty> suite_properties() const override {
+    return {{"bts_Pa"}, {"brazilian_valid"}};
+  }
+  // The first valid disk's strength (else the first disk's, flagged by brazilian_valid 0).
   void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override {
-    if (!v.has("bts_Pa"))
+    const bool valid = r.contains("fracture_origin") && r["fracture_origin"].value("valid", false);
+    if (!v.has("bts_Pa") || (valid && v.get("brazilian_valid") == 0)) {
       v.values["bts_Pa"] = json_number(r, "tensile_strength_Pa", std::nan(""));
+      v.values["brazilian_valid"] = valid ? 1 : 0;
+    }
   }
   // The tensile strength where it is not the peak (taken before the split).
   void plot_markers(const nlohmann::json& r, std::vector<PlotMarker>& m) const override {
@@ -293,6 +314,31 @@ public:
   }
 
 private:
+  // The fracture's origin and the disk's validity (ISRM); a disk without a tensile strength is
+  // not valid whatever its cracks did.
+  static void record_origin(const SplitOrigin& o, bool strength, nlohmann::json& r) {
+    const bool valid = o.valid && strength;
+    r["fracture_origin"] = {
+        {"site", o.site},
+        {"start_position", std::isfinite(o.start) ? nlohmann::json(o.start) : nlohmann::json()},
+        {"platen_share",
+         std::isfinite(o.platen_share) ? nlohmann::json(o.platen_share) : nlohmann::json()},
+        {"cracks", o.cracks},
+        {"valid", valid},
+        {"rule", "cracks within 0.2 D of the loaded diameter up to the tensile strength: the "
+                 "median |y|/(D/2) of their first quarter (start_position: 0 centre, 1 platen) "
+                 "and their share within D/6 of a platen; the disk failed at a platen (not valid, "
+                 "ISRM) when start_position > 2/3 or platen_share > 0.5"}};
+    if (strength && !valid) {
+      char b[256];
+      std::snprintf(b, sizeof b,
+                    "the disk's fracture started at a platen (first cracks at %.2f of the radius, "
+                    "%.0f %% of its diametral cracks within D/6 of a platen): not a valid "
+                    "Brazilian test (ISRM); suites and calibrations leave it out of the mean",
+                    o.start, 100 * o.platen_share);
+      r["warnings"].push_back(std::string(b));
+    }
+  }
   // Bins the cracks formed since the last check (results() finds the split's crack itself).
   bool split_seen(const LoadingFrame& f) {
     if (!bins_)

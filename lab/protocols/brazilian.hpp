@@ -5,7 +5,9 @@
 #include "lab/crack_monitor.hpp"
 #include "lab/frame/loading_frame.hpp"
 
+#include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace rocklab {
@@ -46,5 +48,24 @@ TensionLoss tension_loss(const std::vector<TensionReading>& r, double kept, doub
 /// load -1 when no reading precedes the split.
 LabSample strongest_before(const std::vector<LabSample>& samples, const PeakRecord& peak,
                            std::int64_t split);
+
+/// Where a disk's fracture started (lab/protocols/brazilian_validity.cpp), read from the cracks
+/// within 0.2 D of the loaded diameter up to the step of its tensile strength. A laboratory keeps
+/// a disk whose splitting fracture starts in the centre region and discards one that fails from a
+/// loading point (ISRM 1978).
+struct SplitOrigin {
+  /// "centre": its first cracks lie in the middle third of the diameter; "diameter": between
+  /// that and the outer thirds; "platen": they lie within D/6 of a platen, or most of the damage
+  /// does (crushing at the loading points); "none": no crack in the band.
+  std::string site = "none";
+  double start = std::nan(""); ///< median |y| / (D/2) of the band's first quarter of cracks (>= 3)
+  double platen_share = std::nan(""); ///< the band's cracks within D/6 of a platen (uniform: 1/3)
+  int cracks = 0;                     ///< the band's cracks up to the step
+  bool valid = false;                 ///< the fracture did not start at a platen
+};
+/// A disk whose damage lies mostly at the platens failed there whatever its first cracks did.
+inline constexpr double kPlatenShareInvalid = 0.5;
+SplitOrigin split_origin(const std::vector<Crack>& cracks, const SpecimenGeometry& g,
+                         std::int64_t until);
 
 } // namespace rocklab

@@ -24,6 +24,7 @@ struct PlotLabels {
   std::string x, y;     ///< axis labels
   bool lateral = false; ///< also plot the axial stress against the lateral strain
   int map_axis = 1;     ///< the crack map's section normal (0 x, 1 y, 2 z)
+  std::string curve = "axial stress vs axial strain"; ///< the load curve's legend
 };
 
 /// A property of the material that suites and calibrations derive from a test's results: its name

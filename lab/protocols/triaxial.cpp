@@ -42,6 +42,11 @@ public:
     props["hoek_brown_mi"] = env.has_hb ? number_or_null(env.hb_mi) : none;
     props["hoek_brown_sigma_c_Pa"] = env.has_hb ? number_or_null(env.hb_sigma_c) : none;
     props["envelope_points"] = env.points;
+    // The range the envelope was fitted over: Hoek-Brown fits take sigma3 up to about half the
+    // UCS (Hoek & Brown 1997); m_i from sigma3 <= 0.05 UCS is an extrapolation.
+    props["envelope_sigma3_max_Pa"] = env.sigma3_max;
+    props["envelope_sigma3_max_over_ucs"] = number_or_null(env.sigma3_max / v.get("ucs_Pa"));
+    props["hoek_brown_fit_error"] = env.has_hb ? number_or_null(env.hb_fit_error) : none;
   }
 
 private:

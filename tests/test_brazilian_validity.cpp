@@ -1,0 +1,101 @@
+// The Brazilian disk's validity (ISRM): where its fracture started, from its crack records
+// (lab/protocols/brazilian_validity.cpp), on a disk split from the centre and on disks that failed
+// at a platen.
+#include "lab/protocols/brazilian.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace rocklab;
+
+namespace {
+
+// A 3D disk of D = 26 mm, 12 mm thick, loaded along y (the split band: |x| <= 5.2 mm).
+SpecimenGeometry disk() {
+  SpecimenGeometry g;
+  g.dim = 3, g.diametral = true;
+  g.center = Vec3(0.05, 0.04, 0.006);
+  g.width0 = Vec3(0.026, 0.026, 0);
+  g.thickness = 0.012;
+  return g;
+}
+
+void add(std::vector<Crack>& cracks, const SpecimenGeometry& g, std::int64_t step, double x,
+         double y) {
+  Crack c;
+  c.step = step, c.mode = 1, c.position = g.center + Vec3(x, y, 0.001);
+  cracks.push_back(c);
+}
+
+} // namespace
+
+TEST(BrazilianValidity, ADiskSplitFromItsCentreIsValid) {
+  const SpecimenGeometry g = disk();
+  std::vector<Crack> cracks;
+  // Cracks start at the centre and run out towards both platens, with some scatter off the band
+  // (ignored) and one early crack at a platen.
+  add(cracks, g, 90, 0.0005, 0.0125);
+  std::int64_t step = 100;
+  for (int k = 0; k <= 12; ++k) {
+    const double y = 0.001 * k;
+    add(cracks, g, step++, 0.0004, y);
+    add(cracks, g, step++, -0.0003, -y);
+    add(cracks, g, step++, 0.009, 0.3 * y); // outside the band
+  }
+  const SplitOrigin o = split_origin(cracks, g, step);
+  EXPECT_EQ(o.site, "centre");
+  EXPECT_TRUE(o.valid);
+  EXPECT_LT(o.start, 1.0 / 3.0);
+  EXPECT_EQ(o.cracks, 27);                        // 1 + 2 x 13 in the band
+  EXPECT_NEAR(o.platen_share, 9.0 / 27.0, 1e-12); // |y| > 8.67 mm: 9 of them, the early one too
+  // Only the cracks up to the strength's step count: at step 105 the fracture was at the centre.
+  const SplitOrigin early = split_origin(cracks, g, 105);
+  EXPECT_EQ(early.cracks, 5);
+  EXPECT_TRUE(early.valid);
+}
+
+TEST(BrazilianValidity, ADiskCrushedAtAPlatenIsNotValid) {
+  const SpecimenGeometry g = disk();
+  std::vector<Crack> cracks;
+  // Crushing under the top platen first, then a fracture down the diameter from there.
+  std::int64_t step = 100;
+  for (int k = 0; k < 12; ++k)
+    add(cracks, g, step++, 0.0008 * (k % 5 - 2), 0.0128 - 0.0001 * k);
+  for (int k = 0; k < 12; ++k)
+    add(cracks, g, step++, 0.0002, 0.011 - 0.002 * k);
+  const SplitOrigin o = split_origin(cracks, g, step);
+  EXPECT_EQ(o.site, "platen");
+  EXPECT_FALSE(o.valid);
+  EXPECT_GT(o.start, 0.9);
+  // Its first cracks at the centre would not save a disk whose damage lies mostly at the
+  // platens: both platens crushed, a few cracks in between.
+  std::vector<Crack> crushed;
+  for (int k = 0; k < 5; ++k)
+    add(crushed, g, k, 0, 0.0005 * (k - 2));
+  for (int k = 0; k < 24; ++k)
+    add(crushed, g, 10 + k, 0.001, (k % 2 ? 1 : -1) * (0.0125 - 0.0002 * (k / 2)));
+  const SplitOrigin c = split_origin(crushed, g, 100);
+  EXPECT_LT(c.start, 1.0 / 3.0);
+  EXPECT_NEAR(c.platen_share, 24.0 / 29.0, 1e-12);
+  EXPECT_EQ(c.site, "platen");
+  EXPECT_FALSE(c.valid);
+}
+
+TEST(BrazilianValidity, ScatteredDamageAlongTheDiameterIsValidAndNoCracksIsNone) {
+  // Cracks drawn uniformly along the loaded diameter (a wide strength distribution): a third
+  // near the platens, the start about half-way: "diameter", valid.
+  const SpecimenGeometry g = disk();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> along(-0.013, 0.013), across(-0.005, 0.005);
+  std::vector<Crack> cracks;
+  for (int k = 0; k < 400; ++k)
+    add(cracks, g, k, across(rng), along(rng));
+  const SplitOrigin o = split_origin(cracks, g, 1000);
+  EXPECT_NEAR(o.platen_share, 1.0 / 3.0, 0.06);
+  EXPECT_EQ(o.site, "diameter");
+  EXPECT_TRUE(o.valid);
+  const SplitOrigin none = split_origin({}, g, 1000);
+  EXPECT_EQ(none.site, "none");
+  EXPECT_FALSE(none.valid);
+}
