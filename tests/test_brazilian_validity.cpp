@@ -1,7 +1,9 @@
 // The Brazilian disk's validity (ISRM): where its fracture started, from its crack records
 // (lab/protocols/brazilian_validity.cpp), on a disk split from the centre and on disks that failed
 // at a platen.
+#include "lab/protocol_table.hpp"
 #include "lab/protocols/brazilian.hpp"
+#include "lab/protocols/frame_protocol.hpp"
 
 #include <gtest/gtest.h>
 
@@ -98,4 +100,22 @@ TEST(BrazilianValidity, ScatteredDamageAlongTheDiameterIsValidAndNoCracksIsNone)
   const SplitOrigin none = split_origin({}, g, 1000);
   EXPECT_EQ(none.site, "none");
   EXPECT_FALSE(none.valid);
+}
+
+TEST(BrazilianValidity, ASuiteAveragesItsValidDisksAndCountsThemAll) {
+  const std::unique_ptr<FrameTest> bz = make_frame_test("brazilian");
+  auto disk = [](double strength, bool valid) {
+    return nlohmann::json{{"tensile_strength_Pa", strength},
+                          {"fracture_origin", {{"valid", valid}}}};
+  };
+  SuiteValues v;
+  bz->add_to_suite(disk(5e6, false), v); // crushed at a platen: its strength stands in, flagged
+  EXPECT_DOUBLE_EQ(v.get("bts_Pa"), 5e6);
+  EXPECT_DOUBLE_EQ(v.get("brazilian_valid"), 0);
+  bz->add_to_suite(disk(10e6, true), v);
+  bz->add_to_suite(disk(12e6, true), v);
+  bz->add_to_suite(disk(30e6, false), v);
+  EXPECT_DOUBLE_EQ(v.get("bts_Pa"), 11e6); // the valid disks' mean
+  EXPECT_DOUBLE_EQ(v.get("brazilian_valid"), 0.5);
+  EXPECT_DOUBLE_EQ(v.get("brazilian_disks"), 4);
 }

@@ -4,6 +4,7 @@
 #include "io/input_error.hpp"
 #include "io/json_input.hpp"
 #include "io/output_dir.hpp"
+#include "io/results.hpp"
 #include "lab/protocol_table.hpp"
 #include "lab/suite.hpp"
 #include "materials/material_card.hpp"
@@ -111,7 +112,7 @@ void Evaluator::check_tests(const nlohmann::json& summary, const fs::path& suite
 namespace {
 // A property measured on (or over) the Brazilian disk, other than its validity.
 bool reads_the_disk(const std::string& property) {
-  if (property == "brazilian_valid")
+  if (property == "brazilian_valid" || property == "brazilian_disks")
     return false;
   for (const TargetNeed& n : target_needs())
     if (n.property == property &&
@@ -218,10 +219,11 @@ Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
     const nlohmann::json sm = read_json_file((suite_out / "summary.json").string(), Nulls::Allow);
     check_tests(sm, suite_out, reps[i].tests);
     const nlohmann::json& props = sm["properties"];
-    const bool rejected = props.contains("brazilian_valid") &&
-                          props["brazilian_valid"].is_number() &&
-                          props["brazilian_valid"].get<double>() == 0;
-    ev.rejected_disks += rejected ? 1 : 0;
+    // The share of the seed's disks that were valid, and how many it had (lab/protocols/brazilian).
+    const double valid = json_number(props, "brazilian_valid", 1.0);
+    const bool rejected = valid == 0;
+    ev.rejected_disks +=
+        static_cast<int>(std::lround(json_number(props, "brazilian_disks", 0.0) * (1 - valid)));
     for (const auto& [k, v] : props.items())
       all[k].push_back(v.is_number() && !(rejected && reads_the_disk(k)) ? v.get<double>()
                                                                          : std::nan(""));

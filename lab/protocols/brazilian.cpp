@@ -269,15 +269,23 @@ public:
     }
   }
   std::vector<SuiteProperty> suite_properties() const override {
-    return {{"bts_Pa"}, {"brazilian_valid"}};
+    return {{"bts_Pa"}, {"brazilian_valid"}, {"brazilian_disks"}};
   }
-  // The first valid disk's strength (else the first disk's, flagged by brazilian_valid 0).
+  // The mean strength of the valid disks (ISRM); while none is valid, the first disk's, which
+  // brazilian_valid (the share of valid disks) 0 flags. brazilian_disks counts them all.
   void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override {
     const bool valid = r.contains("fracture_origin") && r["fracture_origin"].value("valid", false);
-    if (!v.has("bts_Pa") || (valid && v.get("brazilian_valid") == 0)) {
-      v.values["bts_Pa"] = json_number(r, "tensile_strength_Pa", std::nan(""));
-      v.values["brazilian_valid"] = valid ? 1 : 0;
+    const double x = json_number(r, "tensile_strength_Pa", std::nan(""));
+    const double n = v.has("brazilian_disks") ? v.get("brazilian_disks") : 0;
+    double k = n > 0 ? std::round(v.get("brazilian_valid") * n) : 0; // valid disks so far
+    if (valid && std::isfinite(x)) {
+      v.values["bts_Pa"] = k > 0 ? (v.get("bts_Pa") * k + x) / (k + 1) : x;
+      k += 1;
+    } else if (n == 0) {
+      v.values["bts_Pa"] = x;
     }
+    v.values["brazilian_disks"] = n + 1;
+    v.values["brazilian_valid"] = k / (n + 1);
   }
   // The tensile strength where it is not the peak (taken before the split).
   void plot_markers(const nlohmann::json& r, std::vector<PlotMarker>& m) const override {
