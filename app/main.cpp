@@ -165,9 +165,7 @@ int calibrate_check(const std::string& file) {
   std::printf("budget       elastic %d, strength %d, ratios %d, polish %d (+1 final); seeds up "
               "to %d where the noise hides a miss; validation on %d-%d fresh seeds from %llu\n",
               c.budget.elastic, c.budget.strength, c.budget.ratios, c.budget.polish,
-              c.budget.max_seeds > 0 ? c.budget.max_seeds
-                                     : std::max(static_cast<int>(c.seeds.size()), 6),
-              c.budget.validation_min, c.budget.validation_max,
+              c.budget.max_seeds, c.budget.validation_min, c.budget.validation_max,
               static_cast<unsigned long long>(c.budget.validation_first));
   return 0;
 }

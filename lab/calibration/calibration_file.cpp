@@ -8,6 +8,7 @@
 #include "lab/protocols/frame_protocol.hpp"
 #include "materials/material_card.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -253,10 +254,13 @@ CalibrationFile load_calibration(const std::string& path) {
   c.budget.ratios = static_cast<int>(b.integer("ratios", 0, 1000, c.budget.ratios));
   c.budget.polish = static_cast<int>(b.integer("polish", 0, 100, c.budget.polish));
   c.budget.sensitivity = b.boolean("sensitivity", c.budget.sensitivity);
+  const int listed = static_cast<int>(c.seeds.size());
   c.budget.max_seeds = static_cast<int>(b.integer("max_seeds", 0, 100, 0));
-  if (c.budget.max_seeds > 0 && c.budget.max_seeds < static_cast<int>(c.seeds.size()))
-    b.fail("max_seeds", "must be 0 (automatic) or at least the " + std::to_string(c.seeds.size()) +
+  if (c.budget.max_seeds > 0 && c.budget.max_seeds < listed)
+    b.fail("max_seeds", "must be 0 (automatic) or at least the " + std::to_string(listed) +
                             " seeds listed in \"seeds\"");
+  if (c.budget.max_seeds == 0) // automatic: the listed seeds, at least 6
+    c.budget.max_seeds = std::max(listed, 6);
   c.budget.validation_min =
       static_cast<int>(b.integer("validation_min", 2, 1000, c.budget.validation_min));
   c.budget.validation_max =

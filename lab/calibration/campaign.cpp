@@ -80,12 +80,8 @@ void print_progress(const std::string& what, const CalibrationFile& c, const Eva
 // error half its tolerance (from the tuned seeds' scatter), within the budget's bounds.
 void validate(Evaluator& ev, const CalibrationFile& c, const std::vector<double>& values,
               ReportInput& r, bool talk) {
-  Measured sd = r.sd; // one tuned seed: its scatter is not known
-  if (r.seeds < 2)
-    for (auto& [k, v] : sd)
-      v = std::nan("");
-  const int n =
-      validation_seed_count(c.targets, sd, c.budget.validation_min, c.budget.validation_max);
+  const int n = validation_seed_count(c.targets, known_scatter(r.sd, r.se), c.budget.validation_min,
+                                      c.budget.validation_max);
   r.validation_seeds = fresh_seeds(c.budget.validation_first, n, ev.seeds());
   if (talk)
     std::fprintf(stderr, "[rocklab calibrate] validation: the fitted card on %d fresh seeds\n", n);
@@ -130,10 +126,8 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
     return m;
   };
   // Where a steered target's miss is within its noise, a seed more (up to the budget's).
-  const int max_seeds =
-      c.budget.max_seeds > 0 ? c.budget.max_seeds : std::max(static_cast<int>(c.seeds.size()), 6);
   const AddSeed add_seed = [&] {
-    const bool added = ev.add_seed(max_seeds);
+    const bool added = ev.add_seed(c.budget.max_seeds);
     if (added && talk)
       std::fprintf(stderr, "[rocklab calibrate] a miss within the noise: seed %llu added\n",
                    static_cast<unsigned long long>(ev.seeds().back()));
@@ -206,9 +200,10 @@ std::string run_pilot(const std::string& file, const EvaluatorOptions& o) {
   std::snprintf(b, sizeof b, "pilot        the start card on %zu seed(s), every test\n",
                 e.folders.size());
   s += b;
+  const Measured scatter = known_scatter(e.sd, e.se);
   for (const Target& t : c.targets) {
     const double sd = value_of(e.sd, t.property);
-    const int need = seeds_needed(t, e.folders.size() > 1 ? sd : std::nan(""));
+    const int need = seeds_needed(t, value_of(scatter, t.property));
     std::snprintf(b, sizeof b, "seeds        %-26s mean %.4g, sd %.3g, standard error %.3g; %s\n",
                   t.property.c_str(), value_of(e.mean, t.property), sd, value_of(e.se, t.property),
                   need < 0 ? "one seed cannot tell its scatter: give 2 or more"

@@ -256,8 +256,7 @@ std::vector<std::string> average_replicates(const std::map<std::string, std::vec
       q += (x - m) * (x - m);
     ev.mean[k] = m;
     ev.sd[k] = v.size() > 1 ? std::sqrt(q / static_cast<double>(v.size() - 1)) : 0.0;
-    ev.n[k] = static_cast<int>(v.size());
-    ev.se[k] = standard_error(ev.sd[k], ev.n[k]);
+    ev.se[k] = standard_error(ev.sd[k], static_cast<int>(v.size()));
     if (!v.empty() && v.size() < all_v.size())
       partial.push_back(k);
   }

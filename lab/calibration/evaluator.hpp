@@ -24,11 +24,9 @@ struct EvaluatorOptions {
 };
 
 /// Properties of one evaluation: the mean over the seeds, the sample standard deviation (0 for
-/// one seed), the standard error of the mean (NaN for one seed) and the seeds that measured it,
-/// by property name.
+/// one seed) and the standard error of the mean (NaN for one seed), by property name.
 struct Evaluation {
   Measured mean, sd, se;
-  std::map<std::string, int> n;
   std::vector<std::string> folders; ///< the suites' output folders, one per seed
   /// Brazilian disks not valid (their fracture started at a platen, ISRM): the properties that
   /// read the disk (bts_Pa, ucs_over_bts, ...) leave those seeds out of their means.
@@ -43,7 +41,7 @@ struct Evaluation {
 /// CPU seconds of the finished child processes (the tests) of this process.
 double children_cpu_seconds();
 
-/// Adds to `ev` the mean, sample standard deviation, standard error and count of each property
+/// Adds to `ev` the mean, sample standard deviation and standard error of each property
 /// over the seeds that measured it (non-finite values are left out; NaN when none did); returns
 /// the properties some seeds did not measure.
 std::vector<std::string> average_replicates(const std::map<std::string, std::vector<double>>& all,

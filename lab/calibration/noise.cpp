@@ -35,6 +35,13 @@ int validation_seed_count(const std::vector<Target>& targets, const Measured& sd
   return std::min(n, most);
 }
 
+Measured known_scatter(const Measured& sd, const Measured& se) {
+  Measured out;
+  for (const auto& [k, v] : sd)
+    out[k] = std::isfinite(value_of(se, k)) ? v : std::nan("");
+  return out;
+}
+
 std::vector<std::uint64_t> fresh_seeds(std::uint64_t first, int count,
                                        const std::vector<std::uint64_t>& used) {
   std::vector<std::uint64_t> out;

@@ -31,6 +31,10 @@ int seeds_needed(const Target& t, double sd, double fraction = 0.5);
 int validation_seed_count(const std::vector<Target>& targets, const Measured& sd, int min_seeds,
                           int max_seeds);
 
+/// The seed-to-seed sd of each property where its standard error is known (two seeds or more
+/// measured it), NaN elsewhere: one seed says nothing about the scatter (its sd reads 0).
+Measured known_scatter(const Measured& sd, const Measured& se);
+
 /// Fresh seeds: `count` seeds from `first` on that are not among `used`.
 std::vector<std::uint64_t> fresh_seeds(std::uint64_t first, int count,
                                        const std::vector<std::uint64_t>& used);

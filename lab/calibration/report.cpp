@@ -18,6 +18,11 @@ std::string fmt(double v, const char* f = "%.4g") {
   return b;
 }
 
+// A target's tolerance as the tables give it: "5 %" (relative) or "± 0.03" (absolute).
+std::string tolerance_cell(const Target& t) {
+  return t.absolute ? "± " + fmt(t.tolerance) : fmt(100 * t.tolerance) + " %";
+}
+
 std::string targets_table(const ReportInput& r) {
   const CalibrationFile& c = *r.file;
   std::string s = "| target | value | tolerance | achieved (mean ± sd over seeds) | error / "
@@ -25,7 +30,7 @@ std::string targets_table(const ReportInput& r) {
   for (const Target& t : c.targets) {
     const double m = value_of(r.outcome->measured, t.property);
     s += "| " + t.property + " | " + fmt(t.value) + " | ";
-    s += t.absolute ? "± " + fmt(t.tolerance) : fmt(100 * t.tolerance) + " %";
+    s += tolerance_cell(t);
     s +=
         " | " + fmt(m) + " ± " + fmt(value_of(r.sd, t.property)) + " | " + fmt(t.error(m)) + " |\n";
   }
@@ -104,8 +109,7 @@ std::string validation_table(const ReportInput& r) {
     const double m = value_of(r.validation_mean, t.property);
     const double se = value_of(r.validation_se, t.property);
     const int need = seeds_needed(t, value_of(r.validation_sd, t.property));
-    s += "| " + t.property + " | " + fmt(t.value) + " | " +
-         (t.absolute ? "± " + fmt(t.tolerance) : fmt(100 * t.tolerance) + " %") + " | " +
+    s += "| " + t.property + " | " + fmt(t.value) + " | " + tolerance_cell(t) + " | " +
          fmt(value_of(r.outcome->measured, t.property)) + " ± " + fmt(value_of(r.se, t.property)) +
          " | " + fmt(m) + " ± " + fmt(se) + " | " + fmt(t.error(m), "%+.2f") + " | " +
          (std::abs(t.error(m)) <= 1 ? "yes" : "**no**") + " | ";

@@ -88,7 +88,7 @@ struct Outcome {
 struct Budget {
   int elastic = 6, strength = 4, ratios = 20, polish = 3;
   /// Replicate seeds per evaluation at most, the file's and those added where the noise
-  /// hides a miss (0: the file's seeds and at least 6)
+  /// hides a miss (a file's 0 is read as its listed seeds, at least 6)
   int max_seeds = 0;
   /// Validation seeds: at least `validation_min`, at most `validation_max` (0: no validation)
   int validation_min = 6, validation_max = 12;
