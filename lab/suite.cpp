@@ -92,7 +92,7 @@ Suite load_suite(const std::string& path) {
     if (!t.shape.is_null())
       shape_from_json(t.shape, s.material.value("dimension", 3), path, tpath + ".shape");
     if (!t.cut.is_null())
-      shape_from_json(t.cut, s.material.value("dimension", 3), path, tpath + ".cut");
+      shape_from_json(t.cut, s.material.value("dimension", 3), path, tpath + ".cut", true);
     t.specimen_key =
         t.shape.dump() + "|" + t.cut.dump() + "|" + (p.seed ? std::to_string(*p.seed) : "card");
     s.tests.push_back(std::move(t));

@@ -17,12 +17,12 @@ double ShapeSpec::volume(int dim) const {
   case SpecimenShape::Rectangle:
     return size.x() * size.y();
   case SpecimenShape::Disk2D:
-    return 0.25 * pi * size.x() * size.x();
+    return 0.25 * size.x() * size.x() * (pi - (flat_angle - std::sin(flat_angle)));
   case SpecimenShape::Prism:
     return size.x() * size.y() * size.z();
   case SpecimenShape::Cylinder:
-  case SpecimenShape::Disk3D:
-    return 0.25 * pi * size.x() * size.x() * size.y();
+  case SpecimenShape::Disk3D: // two circular segments of angle 2a less for flats
+    return 0.25 * size.x() * size.x() * (pi - (flat_angle - std::sin(flat_angle))) * size.y();
   }
   (void)dim;
   return 0;
@@ -33,20 +33,25 @@ bool ShapeSpec::contains(const Vec3& x, double m) const {
   case SpecimenShape::Rectangle:
     return std::abs(x.x()) <= 0.5 * size.x() - m && std::abs(x.y()) <= 0.5 * size.y() - m;
   case SpecimenShape::Disk2D:
-    return std::hypot(x.x(), x.y()) <= 0.5 * size.x() - m;
+    return std::hypot(x.x(), x.y()) <= 0.5 * size.x() - m && within_flats(x, m);
   case SpecimenShape::Prism:
     return std::abs(x.x()) <= 0.5 * size.x() - m && std::abs(x.y()) <= 0.5 * size.y() - m &&
            std::abs(x.z()) <= 0.5 * size.z() - m;
   case SpecimenShape::Cylinder:
   case SpecimenShape::Disk3D:
-    return std::hypot(x.x(), x.y()) <= 0.5 * size.x() - m && std::abs(x.z()) <= 0.5 * size.y() - m;
+    return std::hypot(x.x(), x.y()) <= 0.5 * size.x() - m &&
+           std::abs(x.z()) <= 0.5 * size.y() - m && within_flats(x, m);
   }
   return false;
 }
 
+bool ShapeSpec::within_flats(const Vec3& x, double m) const {
+  return flat_angle <= 0 || std::abs(x.y()) <= 0.5 * size.x() * std::cos(0.5 * flat_angle) - m;
+}
+
 namespace {
 
-ShapeSpec read_shape(JsonObject o, int dim) {
+ShapeSpec read_shape(JsonObject o, int dim, bool cut) {
   ShapeSpec s;
   const std::string shape = dim == 2 ? o.choice("shape", {"rectangle", "disk"})
                                      : o.choice("shape", {"prism", "cylinder", "disk"});
@@ -70,6 +75,13 @@ ShapeSpec read_shape(JsonObject o, int dim) {
     s.size = Vec3(o.number("diameter", pos, std::nullopt, "m"),
                   o.number("thickness", pos, std::nullopt, "m"), 0);
   }
+  if (shape == "disk" && cut) // a flattened Brazilian disk (docs/material-format.md)
+    s.flat_angle =
+        o.number("flat_angle", Range::closed(0, 60), 0.0, "deg") * std::numbers::pi / 180;
+  else if (o.has("flat_angle"))
+    o.fail("flat_angle", shape == "disk" ? "flats are cut: they apply to a disk under 'cut' (cut "
+                                           "from a block), not to a vessel"
+                                         : "applies to a disk only");
   o.finish();
   return s;
 }
@@ -94,17 +106,31 @@ Distribution read_dist(JsonObject& o, const std::string& key, const char* unit) 
 
 } // namespace
 
+namespace {
+/// The flats' loading angle in degrees as a card gives it (rounded back from radians).
+double flat_deg(const ShapeSpec& s) {
+  return std::round(s.flat_angle * 180 / std::numbers::pi * 1e9) / 1e9;
+}
+} // namespace
+
 nlohmann::json shape_json(const ShapeSpec& s, int dim) {
   switch (s.shape) {
   case SpecimenShape::Rectangle:
     return {{"shape", "rectangle"}, {"width", s.size.x()}, {"height", s.size.y()}};
   case SpecimenShape::Disk2D:
+    if (s.flat_angle > 0)
+      return {{"shape", "disk"}, {"diameter", s.size.x()}, {"flat_angle", flat_deg(s)}};
     return {{"shape", "disk"}, {"diameter", s.size.x()}};
   case SpecimenShape::Prism:
     return {{"shape", "prism"}, {"size", {s.size.x(), s.size.y(), s.size.z()}}};
   case SpecimenShape::Cylinder:
     return {{"shape", "cylinder"}, {"diameter", s.size.x()}, {"height", s.size.y()}};
   case SpecimenShape::Disk3D:
+    if (s.flat_angle > 0)
+      return {{"shape", "disk"},
+              {"diameter", s.size.x()},
+              {"thickness", s.size.y()},
+              {"flat_angle", flat_deg(s)}};
     return {{"shape", "disk"}, {"diameter", s.size.x()}, {"thickness", s.size.y()}};
   }
   (void)dim;
@@ -112,15 +138,15 @@ nlohmann::json shape_json(const ShapeSpec& s, int dim) {
 }
 
 ShapeSpec shape_from_json(const nlohmann::json& j, int dim, const std::string& file,
-                          const std::string& key) {
-  return read_shape(JsonObject(j, file, key), dim);
+                          const std::string& key, bool cut) {
+  return read_shape(JsonObject(j, file, key), dim, cut);
 }
 
 void apply_overrides(MaterialCard& card, const GenesisOverrides& o) {
   if (!o.shape.value.is_null())
     card.vessel = shape_from_json(o.shape.value, card.dim, o.shape.file, o.shape.key);
   if (!o.cut.value.is_null())
-    card.cut = shape_from_json(o.cut.value, card.dim, o.cut.file, o.cut.key);
+    card.cut = shape_from_json(o.cut.value, card.dim, o.cut.file, o.cut.key, true);
   if (o.seed)
     card.seed = *o.seed;
 }
@@ -329,9 +355,9 @@ MaterialCard load_material_card(const std::string& path) {
       top.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), 1));
   read_grains(top, c);
   c.porosity = top.number("porosity", {0, 1, true, true}, std::nullopt);
-  c.vessel = read_shape(top.object("specimen"), c.dim);
+  c.vessel = read_shape(top.object("specimen"), c.dim, false);
   if (top.has("cut"))
-    c.cut = read_shape(top.object("cut"), c.dim);
+    c.cut = read_shape(top.object("cut"), c.dim, true);
   if (top.has("clumps")) {
     JsonObject k = top.object("clumps");
     c.clump_max = static_cast<int>(k.integer("max_pebbles", 2, 8));

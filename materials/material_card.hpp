@@ -30,8 +30,12 @@ struct ShapeSpec {
   SpecimenShape shape = SpecimenShape::Prism;
   Vec3 size = Vec3::Zero(); ///< rectangle/prism: edge lengths; cylinder: (D, H, 0); disks: (D,
                             ///< thickness or 0, 0) [m]
+  /// A disk cut with two flats normal to y (a flattened Brazilian disk): the loading angle 2a
+  /// the flats subtend at the centre, each at |y| = R cos a [rad]; 0: round.
+  double flat_angle = 0;
   double volume(int dim) const;
   bool contains(const Vec3& x, double margin = 0) const; ///< x relative to the shape centre
+  bool within_flats(const Vec3& x, double margin) const; ///< |y| inside the flats (or no flats)
 };
 
 /// A planar joint (or a set of parallel ones) inserted as smooth joints.
@@ -102,9 +106,10 @@ struct MaterialCard {
 
 /// A shape as JSON in the card's own form ({"shape": "cylinder", "diameter": .., "height": ..}).
 nlohmann::json shape_json(const ShapeSpec& s, int dim);
-/// Read a shape written by shape_json (or a card's `specimen`); errors name file and key.
+/// Read a shape written by shape_json (or a card's `specimen`; `cut`: a card's `cut`, where a
+/// disk may have flats); errors name file and key.
 ShapeSpec shape_from_json(const nlohmann::json& j, int dim, const std::string& file,
-                          const std::string& key);
+                          const std::string& key, bool cut = false);
 
 /// Read and validate a material card; errors name the file, key, value and allowed range.
 MaterialCard load_material_card(const std::string& path);

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
 #include <random>
 
 using namespace rocklab;
@@ -118,4 +120,25 @@ TEST(BrazilianValidity, ASuiteAveragesItsValidDisksAndCountsThemAll) {
   EXPECT_DOUBLE_EQ(v.get("bts_Pa"), 11e6); // the valid disks' mean
   EXPECT_DOUBLE_EQ(v.get("brazilian_valid"), 0.5);
   EXPECT_DOUBLE_EQ(v.get("brazilian_disks"), 4);
+}
+
+// A flattened disk's centre tension per 2F/(pi D t): the closed form (sin 2a - a)/a against the
+// superposition it comes from. A diametral pair of point loads P at angle phi from the y axis
+// gives the centre 2P/(pi D t) of tension normal to its diameter and 6P/(pi D t) of compression
+// along it; a load spread evenly over the arcs -a..a sums those pairs.
+TEST(FlattenedDisk, TheCentreTensionFactorIsTheSumOfDiametralPointLoads) {
+  EXPECT_DOUBLE_EQ(flat_disk_factor(0), 1.0);
+  for (double deg : {5.0, 20.0, 30.0, 60.0}) {
+    const double a = 0.5 * deg * std::numbers::pi / 180;
+    const int n = 2000; // Simpson over phi in [-a, a] of sigma_xx per 2P/(pi D t) per unit load
+    double sum = 0;
+    for (int i = 0; i <= n; ++i) {
+      const double phi = -a + 2 * a * i / n;
+      const double w = i == 0 || i == n ? 1 : (i % 2 ? 4 : 2);
+      sum += w * (std::cos(phi) * std::cos(phi) - 3 * std::sin(phi) * std::sin(phi));
+    }
+    const double superposed = sum * (2 * a / n) / 3 / (2 * a);
+    EXPECT_NEAR(flat_disk_factor(deg * std::numbers::pi / 180), superposed, 1e-9) << deg;
+  }
+  EXPECT_NEAR(flat_disk_factor(20 * std::numbers::pi / 180), 0.9596, 1e-4);
 }

@@ -200,6 +200,41 @@ TEST(Calibration, StageThreeKeepsThePointThatMeetsEveryTargetOverACloserMiss) {
   EXPECT_EQ(out.params[4].value, asked[2][4]);
 }
 
+TEST(Calibration, StageThreeDoesNotTakeAStepWithinTheNoiseAsProgress) {
+  // Stage 3's points miss the BTS target by 2.0, 1.85 and 1.2 tolerances, each mean with a
+  // standard error of 0.2 tolerances (sums of squares 4 +- 0.8, 3.42 +- 0.74, 1.44 +- 0.48). The
+  // second is no better than the first within the noise: after two points the first is kept; the
+  // third is better by more than twice the noise and replaces it.
+  const std::vector<Target> targets{{kUcs, 4e7, 0.05}, {"bts_Pa", 4e6, 0.1}};
+  const std::vector<double> errs{2.0, 1.85, 1.2};
+  for (int budget : {2, 3}) {
+    std::vector<std::vector<double>> asked;
+    auto rock = [&](const std::vector<double>& v, Stage s) {
+      Measured m{{kUcs, 4e7}, {"bts_Pa", 4e6 * 1.2}, {se_key("bts_Pa"), 4e6 * 0.02}};
+      if (s == Stage::Ratios) {
+        m["bts_Pa"] = 4e6 * (1 + 0.1 * errs[std::min(asked.size(), errs.size() - 1)]);
+        asked.push_back(v);
+      }
+      return m;
+    };
+    const std::vector<Param> params{{"ten", Role::Strength, 1e6, 1e9, 4e7},
+                                    {"gapped", Role::Shape, 0.0, 0.45, 0.1},
+                                    {"slit", Role::Shape, 0.0, 0.45, 0.1}};
+    Budget b;
+    b.ratios = budget;
+    const Outcome out = calibrate(params, targets, rock, b);
+    ASSERT_EQ(asked.size(), static_cast<std::size_t>(budget));
+    ASSERT_NE(asked[0], asked[1]);
+    const std::size_t kept = budget == 2 ? 0 : 2;
+    EXPECT_EQ(out.params[1].value, asked[kept][1]) << "budget " << budget;
+    EXPECT_EQ(out.params[2].value, asked[kept][2]) << "budget " << budget;
+    const bool noted = std::any_of(out.notes.begin(), out.notes.end(), [](const std::string& n) {
+      return n.find("not progress") != std::string::npos;
+    });
+    EXPECT_TRUE(noted) << "budget " << budget;
+  }
+}
+
 TEST(Calibration, ASeedWithoutAMeasurementDoesNotBlankTheEvaluation) {
   // A Brazilian disk that never split on one seed: its BTS is null there.
   const std::map<std::string, std::vector<double>> all{

@@ -595,6 +595,96 @@ TEST(Lab, ABrazilianTestWithoutTheSplitCheckReportsThePeak) {
   EXPECT_FALSE(r.contains("split")) << r.dump(1);
 }
 
+// A disk whose load fell without a split and is pressed on without one is being crushed: the test
+// ends at stop.travel_multiple times the platen travel to the peak (the 3D parallel-bonded suite's
+// disk once ran on towards stop.max_steps). The test disk with a fifth of its contacts bonded (the
+// rest slits) crumbles under the platens without a diametral split even at split_fraction 1.
+TEST(Lab, ABrazilianDiskPressedOnWithoutASplitEndsAtItsTravelLimit) {
+  nlohmann::json card = read_json_file(data("lab_2d_fj.json"));
+  card["flatjoint"]["types"] = {{"bonded", 0.2}, {"gapped", 0.0}, {"slit", 0.8}};
+  const fs::path out = scratch("bz_travel");
+  const std::string card_file = (out.parent_path() / "bz_travel_card.json").string();
+  std::ofstream(card_file) << card.dump();
+  const LabSummary s = run(
+      "bz_travel",
+      {{"test", "brazilian"},
+       {"specimen", {{"material", card_file}, {"shape", {{"shape", "disk"}, {"diameter", 0.02}}}}},
+       {"stop", {{"split_fraction", 1.0}, {"travel_multiple", 1.5}}},
+       {"output", {{"vtk", false}, {"plots", false}}}},
+      out);
+  const nlohmann::json& r = s.results;
+  ASSERT_NE(r["stop_reason"].get<std::string>().find("1.5 times the platen travel to the peak"),
+            std::string::npos)
+      << r["stop_reason"];
+  EXPECT_FALSE(r["split"]["found"].get<bool>());
+  EXPECT_TRUE(r["tensile_strength_Pa"].is_null());
+  // It ended soon after the limit (stop checks come every tenth of a history interval): the last
+  // row of history.csv (axial_strain: the platen travel / D) is just past 1.5 times the peak's.
+  const double peak_strain = r["peak_axial_strain"].get<double>();
+  const auto hist = read_csv(out / "history.csv");
+  ASSERT_EQ(hist[0][3], "axial_strain");
+  const double last = std::stod(hist.back()[3]);
+  EXPECT_GT(last, 1.5 * peak_strain);
+  EXPECT_LT(last, 1.6 * peak_strain);
+  EXPECT_THROW(run("bz_travel_bad",
+                   {{"test", "brazilian"},
+                    {"specimen", {{"file", (out / "specimen.rlspec").string()}}},
+                    {"stop", {{"travel_multiple", 1.2}}}},
+                   scratch("bz_travel_bad")),
+               InputError);
+}
+
+// A flattened disk (a cut disk with flats at a loading angle of 30 deg): no grain centre beyond
+// the flats, the platens on them, the load 2F/(pi D t) times the arc factor (Hondros), and a
+// vessel refuses flats.
+TEST(Lab, AFlattenedDiskIsCutWithFlatsAndLoadedOnThem) {
+  const fs::path out = scratch("bz_flats");
+  const nlohmann::json spec = {
+      {"material", data("lab_2d_fj.json")},
+      {"shape", {{"shape", "rectangle"}, {"width", 0.024}, {"height", 0.024}}},
+      {"cut", {{"shape", "disk"}, {"diameter", 0.02}, {"flat_angle", 30}}}};
+  const LabSummary s = run(
+      "bz_flats",
+      {{"test", "brazilian"}, {"specimen", spec}, {"output", {{"vtk", false}, {"plots", false}}}},
+      out);
+  const nlohmann::json& r = s.results;
+  ASSERT_TRUE(r.contains("flats")) << r.dump(1);
+  EXPECT_DOUBLE_EQ(r["flats"]["loading_angle_deg"].get<double>(), 30.0);
+  const double k = flat_disk_factor(30 * std::numbers::pi / 180);
+  EXPECT_DOUBLE_EQ(r["flats"]["stress_factor"].get<double>(), k);
+  const double d = r["specimen"]["diameter_m"].get<double>();
+  const double load = r["tensile_strength_Pa"].is_number() ? r["tensile_strength_Pa"].get<double>()
+                                                           : r["split"]["peak_Pa"].get<double>();
+  EXPECT_TRUE(
+      test::near_rel(load, k * 2 * r["peak_force_N"].get<double>() / (std::numbers::pi * d), 1e-12))
+      << r.dump(1);
+  // The grains: every centre within the flats (|y| <= R cos 15 deg), and some near them (cut).
+  nlohmann::json meta;
+  const auto m = load_model((out / "specimen.rlspec").string(), &meta);
+  double ymax = 0, xmax = 0;
+  const Vec3 c = Vec3(r["specimen"]["center_m"][0].get<double>(),
+                      r["specimen"]["center_m"][1].get<double>(), 0);
+  for (const Vec3& x : m->balls.pos) {
+    ymax = std::max(ymax, std::abs(x.y() - c.y()));
+    xmax = std::max(xmax, std::abs(x.x() - c.x()));
+  }
+  EXPECT_LE(ymax, 0.01 * std::cos(15 * std::numbers::pi / 180) + 1e-4);
+  EXPECT_GT(xmax, ymax + 1e-4); // round across x, flat along y
+  EXPECT_EQ(meta["report"]["specimen"]["flat_angle"].get<double>(), 30.0);
+  // Flats are cut from a block: a disk vessel refuses them, naming the key.
+  try {
+    run("bz_flats_bad",
+        {{"test", "brazilian"},
+         {"specimen",
+          {{"material", data("lab_2d_fj.json")},
+           {"shape", {{"shape", "disk"}, {"diameter", 0.02}, {"flat_angle", 20}}}}}},
+        scratch("bz_flats_bad"));
+    ADD_FAILURE() << "a vessel with flats was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("flat_angle"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Lab, ABrazilianDiskThatLosesItsPlatenGrainsIsReseatedAndSplits) {
   // The fifth 2D acceptance run's seed 3: a grain sticking out of the cut disk carried the whole
   // platen load; when its bonds broke it slid aside, the load fell to nothing, and the test

@@ -194,12 +194,24 @@ std::string run_pilot(const std::string& file, const EvaluatorOptions& o) {
   std::vector<double> start;
   for (const CardParam& p : c.params)
     start.push_back(p.param.value);
+  // The pilot is one evaluation of every test on every seed: say so before the wait.
+  std::fprintf(stderr,
+               "[rocklab calibrate] pilot: the start card's %zu test(s) on %zu seed(s), in "
+               "%s/evaluations/ (as long as that many suites)\n",
+               c.tests.size(), c.seeds.size(), o.out_dir.c_str());
   const Evaluation e = ev.run(start, Stage::Final);
   std::string s;
   char b[256];
   std::snprintf(b, sizeof b, "pilot        the start card on %zu seed(s), every test\n",
                 e.folders.size());
   s += b;
+  if (e.rejected_disks > 0) {
+    std::snprintf(b, sizeof b,
+                  "pilot        %d Brazilian disk(s) not valid (fracture at a platen, ISRM) left "
+                  "out of the means that read the disk\n",
+                  e.rejected_disks);
+    s += b;
+  }
   const Measured scatter = known_scatter(e.sd, e.se);
   for (const Target& t : c.targets) {
     const double sd = value_of(e.sd, t.property);

@@ -120,6 +120,52 @@ bool is_stress(const std::string& property) {
   return property.size() > 3 && property.ends_with("_Pa") && property != kYoungs;
 }
 
+// Each scale-free target's error in tolerances (a stress X as X / UCS against its target / the
+// UCS target) and its standard error (the ratio's from both relative errors; 0 where a mean has
+// no estimate of its noise).
+std::vector<double> scale_free_errors(const Measured& m, const std::vector<const Target*>& free,
+                                      const Target* tu, std::vector<double>& se) {
+  std::vector<double> e;
+  se.clear();
+  const double u = value_of(m, kUcs);
+  auto rel_se = [&](const std::string& key, double v) {
+    const double s = value_of(m, se_key(key));
+    return std::isfinite(s) && v != 0 ? s / std::abs(v) : 0.0;
+  };
+  for (const Target* t : free) {
+    const double v = value_of(m, t->property);
+    if (is_stress(t->property)) {
+      Target r = *t;
+      r.value = t->value / tu->value;
+      e.push_back(r.error(v / u));
+      se.push_back(std::hypot(rel_se(t->property, v), rel_se(kUcs, u)) * std::abs(v / u) /
+                   (r.value * r.tolerance));
+    } else {
+      e.push_back(t->error(v));
+      const double s = value_of(m, se_key(t->property));
+      se.push_back(std::isfinite(s) ? s / (t->absolute ? 1.0 : t->value) / t->tolerance : 0.0);
+    }
+  }
+  return e;
+}
+
+// The sum of squared errors, its worst term, and its standard error (an error e with standard
+// error s gives e^2 the variance 4 e^2 s^2 + 2 s^4).
+double misfit(const std::vector<double>& errs, const std::vector<double>& se, double& worst,
+              double& f_se) {
+  double sum = 0, var = 0;
+  worst = 0;
+  for (std::size_t i = 0; i < errs.size(); ++i) {
+    const double e = errs[i], s = se[i];
+    sum += std::isfinite(e) ? e * e : 1e6;
+    worst = std::max(worst, std::abs(e));
+    if (std::isfinite(e))
+      var += 4 * e * e * s * s + 2 * s * s * s * s;
+  }
+  f_se = std::sqrt(var);
+  return sum;
+}
+
 struct Campaign {
   std::vector<Param>& p;
   const std::vector<Target>& targets;
@@ -262,15 +308,24 @@ void Campaign::strength(int budget) {
 // Stage 3's best evaluated point. One that meets every scale-free target (where the search stops)
 // beats one with a smaller sum of squared errors that misses one: the Berea campaign kept a point
 // with errors (0.06, -1.18) over the one with (-0.8, -0.92) that met both, and polished the wrong
-// card.
+// card. Between two that both meet or both miss, a smaller sum replaces the kept point only when
+// it is smaller by more than twice the standard error of the difference: a step within the seeds'
+// noise is not progress (BOBYQA itself still sees every mean), and `ties` counts those.
 struct BestPoint {
   double f = kInf; ///< sum of squared errors [tolerances^2]
+  double se = 0;   ///< its standard error from the seeds' scatter [tolerances^2]
   bool met = false;
+  int ties = 0; ///< smaller sums within the noise of the kept one
   std::vector<double> values;
-  void offer(double f_new, bool met_new, const std::vector<Param>& p) {
+  void offer(double f_new, double se_new, bool met_new, const std::vector<Param>& p) {
+    if (met_new == met && f_new < f && f - f_new <= 2 * std::hypot(se, se_new)) {
+      ++ties;
+      return;
+    }
     if (!((met_new && !met) || (met_new == met && f_new < f)))
       return;
     f = f_new;
+    se = se_new;
     met = met_new;
     values.clear();
     for (const Param& q : p)
@@ -295,30 +350,6 @@ void Campaign::ratios(int budget) {
       free.push_back(&t);
   if (shape.empty() || free.empty() || budget < 1)
     return;
-  // Each scale-free target's error in tolerances (a stress X as X / UCS).
-  auto errors = [&](const Measured& m) {
-    std::vector<double> e;
-    const double u = value_of(m, kUcs);
-    for (const Target* t : free) {
-      if (is_stress(t->property)) {
-        Target r = *t;
-        r.value = t->value / tu->value;
-        e.push_back(r.error(value_of(m, t->property) / u));
-      } else {
-        e.push_back(t->error(value_of(m, t->property)));
-      }
-    }
-    return e;
-  };
-  auto misfit = [](const std::vector<double>& errs, double& worst) {
-    double sum = 0;
-    worst = 0;
-    for (double e : errs) {
-      sum += std::isfinite(e) ? e * e : 1e6;
-      worst = std::max(worst, std::abs(e));
-    }
-    return sum;
-  };
   BestPoint best;
   int used = 0;
   const std::size_t n = shape.size();
@@ -344,11 +375,12 @@ void Campaign::ratios(int budget) {
       return HUGE_VAL;
     }
     ++used;
-    const std::vector<double> errs = errors(m);
-    double worst;
-    const double f = misfit(errs, worst);
+    std::vector<double> se;
+    const std::vector<double> errs = scale_free_errors(m, free, tu, se);
+    double worst, f_se;
+    const double f = misfit(errs, se, worst, f_se);
     inert.step(x, errs, p, shape, out.notes);
-    best.offer(f, worst <= 1, p);
+    best.offer(f, f_se, worst <= 1, p);
     const bool all_inert = inert.all_inert();
     if (all_inert)
       out.notes.push_back("stage 3 stopped: every shape parameter is inert");
@@ -372,6 +404,12 @@ void Campaign::ratios(int budget) {
   }
   if (thrown)
     std::rethrow_exception(thrown);
+  if (best.ties > 0)
+    out.notes.push_back("stage 3: " + std::to_string(best.ties) +
+                        " point(s) had a smaller sum of squared errors than the kept one by less "
+                        "than twice the standard error of the difference (the seeds' noise, not "
+                        "progress); the kept point stands (sum " +
+                        num(best.f) + " +- " + num(best.se) + " tolerances^2)");
   for (std::size_t i = 0; i < p.size() && best.values.size() == p.size(); ++i)
     p[i].value = best.values[i];
 }

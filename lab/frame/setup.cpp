@@ -27,10 +27,14 @@ void LoadingFrame::setup() {
     throw InputError(p_.file + ": the specimen has no grains");
   const FrameSetup& setup = setup_;
   std::string shape;
-  if (meta_.contains("report") && meta_["report"].contains("specimen"))
-    shape = meta_["report"]["specimen"].value("shape", "");
+  nlohmann::json spec;
+  if (meta_.contains("report") && meta_["report"].contains("specimen")) {
+    spec = meta_["report"]["specimen"];
+    shape = spec.value("shape", "");
+  }
   measure_specimen(shape, setup.diametral);
   test_.check_shape(shape, p_);
+  test_.read_specimen(spec);
   reference_ = m_.balls.pos;
   m_.balls.track_orientation(p_.orientation); // rotations count from here, like displacements
   const LinearProps props = platen_contact(setup.platen_friction);

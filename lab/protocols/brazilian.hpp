@@ -12,6 +12,11 @@
 
 namespace rocklab {
 
+/// The centre's tensile stress per 2F/(pi D t) when the load is spread uniformly over two arcs
+/// that subtend `loading_angle` = 2a at the centre: (sin 2a - a) / a (Hondros 1959; 1 for a line
+/// load, 0.960 at 2a = 20 deg, 0.910 at 30 deg); a flattened disk's flats load it so.
+double flat_disk_factor(double loading_angle);
+
 /// The step of the crack that completed the diametral split (cracks within 0.2 D of the loaded
 /// diameter spanning `fraction` of its ten bins in one run that bridges at most one empty bin),
 /// or -1 without a split.

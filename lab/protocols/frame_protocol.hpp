@@ -62,6 +62,9 @@ public:
   virtual std::unique_ptr<Actuator> actuator(const Protocol& p) const;
   /// The specimen's shape from its genesis record ("" without one): by default not a disk.
   virtual void check_shape(const std::string& shape, const Protocol& p) const;
+  /// The specimen's shape as its genesis recorded it (the report's `specimen`; null without a
+  /// record), given before loading (default: not read).
+  virtual void read_specimen(const nlohmann::json& /*shape*/) {}
   /// The axial strain of the current reading (called while loading) [-].
   virtual double axial_strain(const LoadingFrame& f) const = 0;
   /// Axial stress and load of a reading whose force and lateral channels are read [Pa].
