@@ -12,17 +12,19 @@
 namespace rocklab {
 
 double ShapeSpec::volume(int dim) const {
-  const double pi = std::numbers::pi;
+  // A disk's face: the circle less the two circular segments of angle 2a the flats cut off.
+  const double face =
+      0.25 * size.x() * size.x() * (std::numbers::pi - (flat_angle - std::sin(flat_angle)));
   switch (shape) {
   case SpecimenShape::Rectangle:
     return size.x() * size.y();
   case SpecimenShape::Disk2D:
-    return 0.25 * size.x() * size.x() * (pi - (flat_angle - std::sin(flat_angle)));
+    return face;
   case SpecimenShape::Prism:
     return size.x() * size.y() * size.z();
   case SpecimenShape::Cylinder:
-  case SpecimenShape::Disk3D: // two circular segments of angle 2a less for flats
-    return 0.25 * size.x() * size.x() * (pi - (flat_angle - std::sin(flat_angle))) * size.y();
+  case SpecimenShape::Disk3D:
+    return face * size.y();
   }
   (void)dim;
   return 0;
@@ -106,35 +108,26 @@ Distribution read_dist(JsonObject& o, const std::string& key, const char* unit) 
 
 } // namespace
 
-namespace {
-/// The flats' loading angle in degrees as a card gives it (rounded back from radians).
-double flat_deg(const ShapeSpec& s) {
-  return std::round(s.flat_angle * 180 / std::numbers::pi * 1e9) / 1e9;
-}
-} // namespace
-
 nlohmann::json shape_json(const ShapeSpec& s, int dim) {
+  nlohmann::json j;
   switch (s.shape) {
   case SpecimenShape::Rectangle:
     return {{"shape", "rectangle"}, {"width", s.size.x()}, {"height", s.size.y()}};
-  case SpecimenShape::Disk2D:
-    if (s.flat_angle > 0)
-      return {{"shape", "disk"}, {"diameter", s.size.x()}, {"flat_angle", flat_deg(s)}};
-    return {{"shape", "disk"}, {"diameter", s.size.x()}};
   case SpecimenShape::Prism:
     return {{"shape", "prism"}, {"size", {s.size.x(), s.size.y(), s.size.z()}}};
   case SpecimenShape::Cylinder:
     return {{"shape", "cylinder"}, {"diameter", s.size.x()}, {"height", s.size.y()}};
+  case SpecimenShape::Disk2D:
+    j = {{"shape", "disk"}, {"diameter", s.size.x()}};
+    break;
   case SpecimenShape::Disk3D:
-    if (s.flat_angle > 0)
-      return {{"shape", "disk"},
-              {"diameter", s.size.x()},
-              {"thickness", s.size.y()},
-              {"flat_angle", flat_deg(s)}};
-    return {{"shape", "disk"}, {"diameter", s.size.x()}, {"thickness", s.size.y()}};
+    j = {{"shape", "disk"}, {"diameter", s.size.x()}, {"thickness", s.size.y()}};
+    break;
   }
+  if (s.flat_angle > 0) // in degrees as a card gives it, rounded back from radians
+    j["flat_angle"] = std::round(s.flat_angle * 180 / std::numbers::pi * 1e9) / 1e9;
   (void)dim;
-  return {};
+  return j;
 }
 
 ShapeSpec shape_from_json(const nlohmann::json& j, int dim, const std::string& file,
