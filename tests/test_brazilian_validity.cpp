@@ -104,6 +104,46 @@ TEST(BrazilianValidity, ScatteredDamageAlongTheDiameterIsValidAndNoCracksIsNone)
   EXPECT_FALSE(none.valid);
 }
 
+// A uniform tension along the loaded diameter scatters its cracks evenly, a third of them within
+// D/6 of a platen. With a few dozen diametral cracks (a 2D disk) the median of the first quarter
+// then lies in an outer third of 32 % of disks by chance alone (at least 3 of 6): a rule on the
+// median only calls every third evenly cracked disk "started at a platen". Counted only beyond
+// chance (binomial tail at most 0.05), at most about one in twenty is.
+TEST(BrazilianValidity, AnEvenScatterOfAFewCracksIsNotReadAsAPlatenStart) {
+  EXPECT_NEAR(binomial_upper_tail(4, 7, 1.0 / 3.0), 379.0 / 2187.0, 1e-12); // 0.1733
+  EXPECT_NEAR(binomial_upper_tail(6, 6, 1.0 / 3.0), 1.0 / 729.0, 1e-15);
+  EXPECT_DOUBLE_EQ(binomial_upper_tail(0, 6, 1.0 / 3.0), 1.0);
+  EXPECT_DOUBLE_EQ(binomial_upper_tail(7, 6, 1.0 / 3.0), 0.0);
+  EXPECT_NEAR(binomial_upper_tail(200, 400, 1.0 / 3.0), 0.0, 1e-10); // no overflow at 400
+  const SpecimenGeometry g = disk();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> along(-0.013, 0.013), across(-0.005, 0.005);
+  const int draws = 4000;
+  int median_outer = 0, invalid = 0;
+  for (int d = 0; d < draws; ++d) {
+    std::vector<Crack> cracks;
+    for (int k = 0; k < 24; ++k)
+      add(cracks, g, k, across(rng), along(rng));
+    const SplitOrigin o = split_origin(cracks, g, 1000);
+    ASSERT_EQ(o.first, 6);
+    median_outer += o.start > 2.0 / 3.0;
+    invalid += !o.valid;
+  }
+  EXPECT_NEAR(median_outer / double(draws), 0.320, 0.03); // 1 - P(at most 2 of 6)
+  EXPECT_LT(invalid / double(draws), 0.06);
+  // Five of the first six at a platen is not chance (1.8 %): that disk started there.
+  std::vector<Crack> cracks;
+  for (int k = 0; k < 5; ++k)
+    add(cracks, g, k, 0.0005, 0.0122 - 0.0002 * k);
+  for (int k = 0; k < 19; ++k)
+    add(cracks, g, 10 + k, 0.0005, 0.0125 - 0.0013 * k);
+  const SplitOrigin o = split_origin(cracks, g, 1000);
+  EXPECT_EQ(o.first_at_platen, 6); // the run down the diameter begins under the platen too
+  EXPECT_LT(o.start_chance, kPlatenChance);
+  EXPECT_EQ(o.site, "platen");
+  EXPECT_FALSE(o.valid);
+}
+
 TEST(BrazilianValidity, ASuiteAveragesItsValidDisksAndCountsThemAll) {
   const std::unique_ptr<FrameTest> bz = make_frame_test("brazilian");
   auto disk = [](double strength, bool valid) {

@@ -98,8 +98,9 @@ public:
   const char* name() const override { return "brazilian"; }
   // 2: strength before the split; 4: one bridge; 5: re-seating after a collapse without a split;
   // 6: strength before the loss of the diametral tension; 7: the fracture's origin (validity);
-  // 8: a disk pressed travel_multiple times its peak's travel without a split ends
-  int revision() const override { return 8; }
+  // 8: a disk pressed travel_multiple times its peak's travel without a split ends; 9: a platen
+  // start counts only beyond chance
+  int revision() const override { return 9; }
   void read_options(JsonObject& loading, JsonObject& stop, const Protocol& p) override {
     if (loading.choice("jaws", {"flat", "curved"}, "flat") == "curved")
       jaw_ratio_ = loading.number("jaw_radius_ratio", Range::closed(1.1, 10), 1.5);
@@ -288,12 +289,14 @@ public:
     print_tensile_strength(r, more);
     if (r.contains("fracture_origin")) {
       const nlohmann::json& o = r["fracture_origin"];
-      std::printf("fracture     started %s (first cracks at %.2f of the radius, %.0f %% of the "
-                  "diametral cracks within D/6 of a platen): %s\n",
+      std::printf("fracture     started %s (first cracks at %.2f of the radius, %d of %d within "
+                  "D/6 of a platen, chance %.2g; %.0f %% of the diametral cracks): %s\n",
                   o["site"] == "centre"     ? "in the centre"
                   : o["site"] == "diameter" ? "along the diameter"
                                             : "at a platen",
                   json_number(o, "start_position", std::nan("")),
+                  o.value("first_cracks_at_platen", 0), o.value("first_cracks", 0),
+                  json_number(o, "start_chance", std::nan("")),
                   100 * json_number(o, "platen_share", std::nan("")),
                   o["valid"].get<bool>() ? "valid (ISRM)" : "NOT valid (ISRM: discard the disk)");
     }
@@ -356,17 +359,23 @@ private:
   // not valid whatever its cracks did.
   static void record_origin(const SplitOrigin& o, bool strength, nlohmann::json& r) {
     const bool valid = o.valid && strength;
+    auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); };
     r["fracture_origin"] = {
         {"site", o.site},
-        {"start_position", std::isfinite(o.start) ? nlohmann::json(o.start) : nlohmann::json()},
-        {"platen_share",
-         std::isfinite(o.platen_share) ? nlohmann::json(o.platen_share) : nlohmann::json()},
+        {"start_position", number(o.start)},
+        {"platen_share", number(o.platen_share)},
         {"cracks", o.cracks},
+        {"first_cracks", o.first},
+        {"first_cracks_at_platen", o.first_at_platen},
+        {"start_chance", number(o.start_chance)},
+        {"share_chance", number(o.share_chance)},
         {"valid", valid},
         {"rule", "cracks within 0.2 D of the loaded diameter up to the tensile strength: the "
                  "median |y|/(D/2) of their first quarter (start_position: 0 centre, 1 platen) "
                  "and their share within D/6 of a platen; the disk failed at a platen (not valid, "
-                 "ISRM) when start_position > 2/3 or platen_share > 0.5"}};
+                 "ISRM) when start_position > 2/3 or platen_share > 0.5 and an even scatter "
+                 "along the diameter (a third within D/6 of a platen) puts that many there with "
+                 "a chance of at most 0.05 (start_chance, share_chance: binomial tails)"}};
     if (strength && !valid) {
       char b[256];
       std::snprintf(b, sizeof b,

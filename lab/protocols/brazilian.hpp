@@ -60,16 +60,26 @@ LabSample strongest_before(const std::vector<LabSample>& samples, const PeakReco
 /// loading point (ISRM 1978).
 struct SplitOrigin {
   /// "centre": its first cracks lie in the middle third of the diameter; "diameter": between
-  /// that and the outer thirds; "platen": they lie within D/6 of a platen, or most of the damage
-  /// does (crushing at the loading points); "none": no crack in the band.
+  /// that and the outer thirds, or scattered along it; "platen": they lie within D/6 of a platen,
+  /// or most of the damage does (crushing at the loading points), more than a scatter along the
+  /// diameter puts there by chance; "none": no crack in the band.
   std::string site = "none";
   double start = std::nan(""); ///< median |y| / (D/2) of the band's first quarter of cracks (>= 3)
   double platen_share = std::nan(""); ///< the band's cracks within D/6 of a platen (uniform: 1/3)
   int cracks = 0;                     ///< the band's cracks up to the step
-  bool valid = false;                 ///< the fracture did not start at a platen
+  int first = 0;                      ///< the first quarter's cracks (at least 3)
+  int first_at_platen = 0;            ///< of those, within D/6 of a platen
+  /// The chance that cracks scattered evenly along the diameter put at least as many of the first
+  /// quarter (start) or of all (share) within D/6 of a platen: the one-sided binomial tail.
+  double start_chance = std::nan(""), share_chance = std::nan("");
+  bool valid = false; ///< the fracture did not start at a platen
 };
 /// A disk whose damage lies mostly at the platens failed there whatever its first cracks did.
 inline constexpr double kPlatenShareInvalid = 0.5;
+/// A platen start must be more than chance: at most this probability under an even scatter.
+inline constexpr double kPlatenChance = 0.05;
+/// P(X >= k) for X ~ Binomial(n, p).
+double binomial_upper_tail(int k, int n, double p);
 SplitOrigin split_origin(const std::vector<Crack>& cracks, const SpecimenGeometry& g,
                          std::int64_t until);
 
