@@ -571,6 +571,52 @@ TEST(Lab, CurvedJawsLoadTheDiskOverAnArcAndSplitIt) {
   EXPECT_EQ(r["platen_reseats"].get<int>(), 0);
 }
 
+// A cushion between platen and disk (loading.platen_stiffness_ratio, the role of a bearing strip):
+// the platen contacts are softer, so the platens travel further to the same load and spread it
+// over more of the disk's surface grains; the disk's strength is its own. A ratio outside (0, 1]
+// is refused, and a UCS refuses the key as the Brazilian's.
+TEST(Lab, ACushionedPlatenTravelsFurtherAndMeasuresTheSameDisk) {
+  const LabSummary& flat = flat_disk_run();
+  const std::string spec = (test::scratch_root() / "bz_flat" / "specimen.rlspec").string();
+  auto cushioned = [&](const std::string& name, double ratio) {
+    return run(name,
+               {{"test", "brazilian"},
+                {"specimen", {{"file", spec}}},
+                {"loading", {{"platen_stiffness_ratio", ratio}}},
+                {"output", {{"vtk", false}, {"plots", false}}}},
+               scratch(name));
+  };
+  const LabSummary c = cushioned("bz_cushion", 0.1);
+  const nlohmann::json& r = c.results;
+  ASSERT_EQ(r["jaws"]["stiffness_ratio"].get<double>(), 0.1) << r.dump(1);
+  EXPECT_EQ(flat.results["jaws"]["stiffness_ratio"].get<double>(), 1.0);
+  EXPECT_TRUE(r["split"]["found"].get<bool>()) << r["stop_reason"];
+  // Two soft contacts in series with the disk: the platen travel to the peak grows.
+  EXPECT_GT(r["peak_axial_strain"].get<double>(),
+            1.3 * flat.results["peak_axial_strain"].get<double>());
+  const double bts = r["tensile_strength_Pa"].get<double>();
+  const double bts_flat = flat.results["tensile_strength_Pa"].get<double>();
+  EXPECT_GT(bts, 0.7 * bts_flat);
+  EXPECT_LT(bts, 1.5 * bts_flat);
+  for (const double bad : {0.0, 1.5})
+    try {
+      cushioned("bz_cushion_bad", bad);
+      ADD_FAILURE() << "platen_stiffness_ratio " << bad << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("platen_stiffness_ratio"), std::string::npos);
+    }
+  try {
+    run("bz_cushion_ucs",
+        {{"test", "ucs"},
+         {"specimen", {{"file", spec}}},
+         {"loading", {{"platen_stiffness_ratio", 0.1}}}},
+        scratch("bz_cushion_ucs"));
+    ADD_FAILURE() << "a UCS took a cushion";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("brazilian"), std::string::npos) << e.what();
+  }
+}
+
 // stop.split_fraction 0 turns the split check off: the strength is the peak, and results.json
 // says so (a rename once mangled this text into "stosplit_fraction_ 0").
 TEST(Lab, ABrazilianTestWithoutTheSplitCheckReportsThePeak) {

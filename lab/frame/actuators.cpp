@@ -56,6 +56,11 @@ void Platens::mount(Model& m, const SpecimenGeometry& g, const LinearProps& cont
   LinearProps props = contact;
   if (friction_ >= 0)
     props.fric = friction_;
+  // A cushion (loading.platen_stiffness_ratio): every platen contact softer by the same factor,
+  // whether its stiffness is given (kn, ks) or follows from the modulus (deformability).
+  props.kn *= stiffness_;
+  props.ks *= stiffness_;
+  props.emod *= stiffness_;
   if (g.diametral && jaw_ratio_ > 0) {
     top_ = add_machine_wall(m, curved_jaw(m, g, "platen.top", 1), props);
     bottom_ = add_machine_wall(m, curved_jaw(m, g, "platen.bottom", -1), props);

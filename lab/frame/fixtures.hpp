@@ -60,8 +60,10 @@ public:
 class Platens final : public Actuator {
 public:
   /// jaw_ratio > 0: ISRM curved jaws of this times the disk's radius (diametral specimens);
-  /// friction >= 0: the platens' ball-facet friction coefficient, else the contact's own.
-  Platens(double jaw_ratio, double friction) : jaw_ratio_(jaw_ratio), friction_(friction) {}
+  /// friction >= 0: the platens' ball-facet friction coefficient, else the contact's own;
+  /// stiffness: the platens' contact stiffness over the contact's own, (0, 1] (< 1: a cushion).
+  Platens(double jaw_ratio, double friction, double stiffness = 1)
+      : jaw_ratio_(jaw_ratio), friction_(friction), stiffness_(stiffness) {}
   void mount(Model& m, const SpecimenGeometry& g, const LinearProps& contact,
              const std::string& file) override;
   void drive(Model& m, const SpecimenGeometry& g, double v) const override;
@@ -75,7 +77,7 @@ public:
 private:
   Wall curved_jaw(const Model& m, const SpecimenGeometry& g, const std::string& name,
                   int side) const;
-  double jaw_ratio_, friction_;
+  double jaw_ratio_, friction_, stiffness_;
   std::int64_t top_ = -1, bottom_ = -1;
 };
 

@@ -106,6 +106,7 @@ public:
       jaw_ratio_ = loading.number("jaw_radius_ratio", Range::closed(1.1, 10), 1.5);
     else if (loading.has("jaw_radius_ratio"))
       loading.fail("jaw_radius_ratio", "applies to \"jaws\": \"curved\" only");
+    cushion_ = loading.number("platen_stiffness_ratio", {0, 1, true, false}, 1);
     split_fraction_ = stop.number("split_fraction", Range::closed(0, 1), 0.6);
     failed_fraction_ = stop.number("failed_fraction", {0, 1, true, false}, 0.3);
     if (failed_fraction_ >= p.post_peak_fraction)
@@ -122,7 +123,7 @@ public:
     return s;
   }
   std::unique_ptr<Actuator> actuator(const Protocol& p) const override {
-    return std::make_unique<Platens>(jaw_ratio_, p.platen_friction);
+    return std::make_unique<Platens>(jaw_ratio_, p.platen_friction, cushion_);
   }
 
   void check_shape(const std::string& shape, const Protocol& p) const override {
@@ -204,6 +205,7 @@ public:
                     ? nlohmann::json{{"shape", "curved"},
                                      {"radius_m", curved_jaw_radius(jaw_ratio_, f.geometry())}}
                     : nlohmann::json{{"shape", "flat"}};
+    r["jaws"]["stiffness_ratio"] = cushion_;
     if (split_fraction_ <= 0) { // the split check is off: the peak, as the user asked
       r["tensile_strength_Pa"] = peak.load;
       r["tensile_strength_method"] = "the peak of 2F/(pi D t) (stop.split_fraction 0)";
@@ -402,6 +404,7 @@ private:
   std::vector<TensionReading> tension_; ///< the diametral tension per unit force while loading
   // options
   double jaw_ratio_ = 0;         ///< curved jaws of this times the disk's radius; 0: flat platens
+  double cushion_ = 1;           ///< platen contact stiffness over the specimen's wall contact
   double split_fraction_ = 0.6;  ///< stop.split_fraction (0: no split check)
   double failed_fraction_ = 0.3; ///< stop.failed_fraction
   double travel_multiple_ = 3;   ///< stop.travel_multiple (0: off)
