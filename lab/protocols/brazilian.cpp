@@ -375,9 +375,10 @@ private:
         {"rule", "cracks within 0.2 D of the loaded diameter up to the tensile strength: the "
                  "median |y|/(D/2) of their first quarter (start_position: 0 centre, 1 platen) "
                  "and their share within D/6 of a platen; the disk failed at a platen (not valid, "
-                 "ISRM) when start_position > 2/3 or platen_share > 0.5 and an even scatter "
-                 "along the diameter (a third within D/6 of a platen) puts that many there with "
-                 "a chance of at most 0.05 (start_chance, share_chance: binomial tails)"}};
+                 "ISRM) when start_position > 2/3 or platen_share > 0.5, each only where an "
+                 "even scatter along the diameter (a third within D/6 of a platen) puts that "
+                 "many cracks there with a chance of at most 0.05 (start_chance, share_chance: "
+                 "binomial tails)"}};
     if (strength && !valid) {
       char b[256];
       std::snprintf(b, sizeof b,
