@@ -411,10 +411,12 @@ std::string summary_table(const nlohmann::json& sm) {
   t += line;
   std::snprintf(line, sizeof line,
                 "Mohr-Coulomb: friction angle %s deg, cohesion %s MPa (R2 %s)   Hoek-Brown m_i %s "
-                "(%d points)\n",
+                "(%d points, sigma3 up to %s UCS, fit error %s)\n",
                 mpa(p["friction_angle_deg"], 1).c_str(), mpa(p["cohesion_Pa"], 1e-6).c_str(),
                 mpa(p["mohr_coulomb_r2"], 1).c_str(), mpa(p["hoek_brown_mi"], 1).c_str(),
-                p["envelope_points"].get<int>());
+                p["envelope_points"].get<int>(),
+                mpa(p.value("envelope_sigma3_max_over_ucs", nlohmann::json()), 1).c_str(),
+                mpa(p.value("hoek_brown_fit_error", nlohmann::json()), 1).c_str());
   t += line;
   // Every other property a test declares (a new test's shows here without editing this table).
   const std::set<std::string> printed(std::begin(kHeadline), std::end(kHeadline));
