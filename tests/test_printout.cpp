@@ -117,4 +117,13 @@ TEST(Printout, EveryDeclaredSuitePropertyIsAColumnOfTheSuiteTables) {
   for (std::size_t k = 9; k < cols.size(); ++k)
     EXPECT_NE(table.find(cols[k] + " 1.5"), std::string::npos) << cols[k] << "\n" << table;
   EXPECT_NE(table.find("E 1.5e-09 GPa"), std::string::npos) << table;
+  // The envelope's m_i comes with the sigma3 range it was fitted over and its fit error.
+  EXPECT_NE(table.find("(3 points, sigma3 up to - UCS, fit error -)"), std::string::npos) << table;
+  json fitted = summary;
+  fitted["properties"]["envelope_sigma3_max_over_ucs"] = 0.25;
+  fitted["properties"]["hoek_brown_fit_error"] = 0.156;
+  EXPECT_NE(
+      summary_table(fitted).find("m_i 1.5 (3 points, sigma3 up to 0.25 UCS, fit error 0.156)"),
+      std::string::npos)
+      << summary_table(fitted);
 }
