@@ -102,6 +102,20 @@ private:
   unsigned serial_ = 0;
 };
 
+// This process's executable as it was started: /proc/self/exe's target, without the " (deleted)"
+// the kernel appends once the file is replaced (a rebuild relinks it) or removed.
+const std::string& own_executable() {
+  static const std::string path = [] {
+    std::error_code ec;
+    std::string p = std::filesystem::read_symlink("/proc/self/exe", ec).string();
+    const std::string_view gone = " (deleted)";
+    if (p.size() > gone.size() && p.compare(p.size() - gone.size(), gone.size(), gone) == 0)
+      p.resize(p.size() - gone.size());
+    return ec ? std::string() : p;
+  }();
+  return path;
+}
+
 pid_t spawn(const Job& j) {
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
@@ -124,7 +138,12 @@ pid_t spawn(const Job& j) {
     env.push_back(e.data());
   env.push_back(nullptr);
   pid_t pid = -1;
-  const int rc = posix_spawn(&pid, args[0], &fa, nullptr, args.data(), env.data());
+  // A child that runs this program starts from the file this process runs, which /proc/self/exe
+  // keeps even when a rebuild has replaced (or is relinking) the file at its path: a suite once
+  // stopped at "cannot start .../rocklab: Permission denied" mid-way through a rebuild.
+  const bool self = !own_executable().empty() && j.argv[0] == own_executable();
+  const int rc =
+      posix_spawn(&pid, self ? "/proc/self/exe" : args[0], &fa, nullptr, args.data(), env.data());
   posix_spawn_file_actions_destroy(&fa);
   if (rc != 0)
     throw std::runtime_error("cannot start " + j.argv[0] + ": " + std::strerror(rc));

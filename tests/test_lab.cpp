@@ -960,6 +960,39 @@ TEST(Lab, AChildStoppedFromOutsideStopsTheSuiteAsInterrupted) {
   EXPECT_EQ(jobs[2].status, 0);
 }
 
+// A rebuild replaces the rocklab file while a suite (or a calibration) runs: its next test must
+// still start, from the program the suite itself runs (a study once stopped at "cannot start
+// .../rocklab: Permission denied"). Here the suite's copy of the program is deleted a second
+// after it starts, during its genesis; one test at a time keeps it running for several more.
+TEST(Lab, ASuiteFinishesWhenItsProgramFileIsReplacedMidway) {
+  const fs::path dir = test::scratch_root() / "suite_gone";
+  fs::create_directories(dir);
+  nlohmann::json suite{{"name", "gone"},
+                       {"material", data("lab_2d_fj.json")},
+                       {"parallel", 1},
+                       {"tests",
+                        {{{"name", "ucs"}, {"test", "ucs"}, {"output", {{"vtk", false}}}},
+                         {{"name", "bz"},
+                          {"test", "brazilian"},
+                          {"shape", {{"shape", "disk"}, {"diameter", 0.02}}},
+                          {"output", {{"vtk", false}}}}}}};
+  std::ofstream(dir / "suite.json") << suite.dump(2);
+  const fs::path copy = dir / "rocklab";
+  fs::copy_file(test::binary(), copy, fs::copy_options::overwrite_existing);
+  const fs::path out = scratch("suite_gone_out");
+  std::string msg;
+  const int rc = test::run_command(
+      "( " + copy.string() + " suite " + (dir / "suite.json").string() + " -o " + out.string() +
+          " --threads 1 & p=$!; sleep 1; rm " + copy.string() + "; wait $p )",
+      &msg);
+  EXPECT_FALSE(fs::exists(copy));
+  ASSERT_EQ(rc, 0) << msg;
+  const nlohmann::json sm = read_json_file((out / "summary.json").string(), Nulls::Allow);
+  ASSERT_EQ(sm["tests"].size(), 2u);
+  for (const auto& row : sm["tests"])
+    EXPECT_EQ(row["status"], "ok") << row.dump();
+}
+
 TEST(Lab, SuiteRunsTestsInParallelAndSummarises) {
   const fs::path dir = test::scratch_root() / "suite";
   fs::create_directories(dir);
