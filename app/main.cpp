@@ -173,7 +173,7 @@ int calibrate_check(const std::string& file) {
 rocklab::calibration::EvaluatorOptions calibrate_options(const std::string& out_dir, int jobs) {
   rocklab::calibration::EvaluatorOptions o;
   o.out_dir = out_dir;
-  o.executable = std::filesystem::read_symlink("/proc/self/exe").string();
+  o.executable = rocklab::own_executable();
   o.jobs = jobs;
   o.interrupt = &g_interrupt;
   return o;
@@ -217,7 +217,7 @@ int suite_command(const std::string& suite_file, const std::string& out_dir, boo
   const rocklab::Suite s = rocklab::load_suite(suite_file);
   rocklab::SuiteOptions o;
   o.out_dir = out_dir;
-  o.executable = std::filesystem::read_symlink("/proc/self/exe").string();
+  o.executable = rocklab::own_executable();
   o.threads = threads;
   o.progress = !quiet;
   o.interrupt = &g_interrupt;

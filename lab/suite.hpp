@@ -32,6 +32,11 @@ struct Suite {
 /// file and the key, e.g. tests[2].loading.confinement).
 Suite load_suite(const std::string& path);
 
+/// This program's executable as it was started (/proc/self/exe's target; "" where there is none):
+/// the binary a suite or a calibration runs its tests with. Children started from it run this very
+/// file even after a rebuild replaced the one at its path (lab/suite_jobs.cpp).
+const std::string& own_executable();
+
 struct SuiteOptions {
   std::string out_dir;
   std::string executable; ///< the rocklab binary that runs each test (this process's own)

@@ -33,6 +33,20 @@ std::vector<int> share_cores(int cores, std::size_t running) {
   return share;
 }
 
+// This process's executable as it was started: /proc/self/exe's target, without the " (deleted)"
+// the kernel appends once the file is replaced (a rebuild relinks it) or removed.
+const std::string& own_executable() {
+  static const std::string path = [] {
+    std::error_code ec;
+    std::string p = std::filesystem::read_symlink("/proc/self/exe", ec).string();
+    const std::string_view gone = " (deleted)";
+    if (p.size() > gone.size() && p.compare(p.size() - gone.size(), gone.size(), gone) == 0)
+      p.resize(p.size() - gone.size());
+    return ec ? std::string() : p;
+  }();
+  return path;
+}
+
 namespace {
 
 // The leases of this process's children (src/core/thread_lease.hpp), in start order: the cores
@@ -101,20 +115,6 @@ private:
   int cores_ = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   unsigned serial_ = 0;
 };
-
-// This process's executable as it was started: /proc/self/exe's target, without the " (deleted)"
-// the kernel appends once the file is replaced (a rebuild relinks it) or removed.
-const std::string& own_executable() {
-  static const std::string path = [] {
-    std::error_code ec;
-    std::string p = std::filesystem::read_symlink("/proc/self/exe", ec).string();
-    const std::string_view gone = " (deleted)";
-    if (p.size() > gone.size() && p.compare(p.size() - gone.size(), gone.size(), gone) == 0)
-      p.resize(p.size() - gone.size());
-    return ec ? std::string() : p;
-  }();
-  return path;
-}
 
 pid_t spawn(const Job& j) {
   posix_spawn_file_actions_t fa;

@@ -361,16 +361,15 @@ private:
   // not valid whatever its cracks did.
   static void record_origin(const SplitOrigin& o, bool strength, nlohmann::json& r) {
     const bool valid = o.valid && strength;
-    auto number = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); };
     r["fracture_origin"] = {
         {"site", o.site},
-        {"start_position", number(o.start)},
-        {"platen_share", number(o.platen_share)},
+        {"start_position", number_or_null(o.start)},
+        {"platen_share", number_or_null(o.platen_share)},
         {"cracks", o.cracks},
         {"first_cracks", o.first},
         {"first_cracks_at_platen", o.first_at_platen},
-        {"start_chance", number(o.start_chance)},
-        {"share_chance", number(o.share_chance)},
+        {"start_chance", number_or_null(o.start_chance)},
+        {"share_chance", number_or_null(o.share_chance)},
         {"valid", valid},
         {"rule", "cracks within 0.2 D of the loaded diameter up to the tensile strength: the "
                  "median |y|/(D/2) of their first quarter (start_position: 0 centre, 1 platen) "
