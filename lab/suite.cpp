@@ -409,14 +409,23 @@ std::string summary_table(const nlohmann::json& sm) {
                 mpa(p["ucs_Pa"], 1e-6).c_str(), mpa(p["bts_Pa"], 1e-6).c_str(),
                 mpa(p["direct_tension_Pa"], 1e-6).c_str(), mpa(p["ucs_over_bts"], 1).c_str());
   t += line;
-  std::snprintf(line, sizeof line,
-                "Mohr-Coulomb: friction angle %s deg, cohesion %s MPa (R2 %s)   Hoek-Brown m_i %s "
-                "(%d points, sigma3 up to %s UCS, fit error %s)\n",
-                mpa(p["friction_angle_deg"], 1).c_str(), mpa(p["cohesion_Pa"], 1e-6).c_str(),
-                mpa(p["mohr_coulomb_r2"], 1).c_str(), mpa(p["hoek_brown_mi"], 1).c_str(),
-                p["envelope_points"].get<int>(),
-                mpa(p.value("envelope_sigma3_max_over_ucs", nlohmann::json()), 1).c_str(),
-                mpa(p.value("hoek_brown_fit_error", nlohmann::json()), 1).c_str());
+  // The envelope line only where compression peaks at two confinements or more gave one; a
+  // suite without triaxial tests says so instead of a row of dashes.
+  const int envelope_points = p.value("envelope_points", 0);
+  if (envelope_points < 2)
+    std::snprintf(line, sizeof line,
+                  "Envelope: none (%d compression peak%s; Mohr-Coulomb needs 2 confinements, "
+                  "Hoek-Brown 3)\n",
+                  envelope_points, envelope_points == 1 ? "" : "s");
+  else
+    std::snprintf(line, sizeof line,
+                  "Mohr-Coulomb: friction angle %s deg, cohesion %s MPa (R2 %s)   Hoek-Brown m_i "
+                  "%s (%d points, sigma3 up to %s UCS, fit error %s)\n",
+                  mpa(p["friction_angle_deg"], 1).c_str(), mpa(p["cohesion_Pa"], 1e-6).c_str(),
+                  mpa(p["mohr_coulomb_r2"], 1).c_str(), mpa(p["hoek_brown_mi"], 1).c_str(),
+                  envelope_points,
+                  mpa(p.value("envelope_sigma3_max_over_ucs", nlohmann::json()), 1).c_str(),
+                  mpa(p.value("hoek_brown_fit_error", nlohmann::json()), 1).c_str());
   t += line;
   // Every other property a test declares (a new test's shows here without editing this table).
   const std::set<std::string> printed(std::begin(kHeadline), std::end(kHeadline));

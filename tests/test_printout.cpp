@@ -126,4 +126,13 @@ TEST(Printout, EveryDeclaredSuitePropertyIsAColumnOfTheSuiteTables) {
       summary_table(fitted).find("m_i 1.5 (3 points, sigma3 up to 0.25 UCS, fit error 0.156)"),
       std::string::npos)
       << summary_table(fitted);
+  // A suite without triaxial tests has no envelope: one line says so, not a row of dashes.
+  json bare = summary;
+  bare["properties"]["envelope_points"] = 1;
+  const std::string none = summary_table(bare);
+  EXPECT_NE(none.find("Envelope: none (1 compression peak; Mohr-Coulomb needs 2 confinements, "
+                      "Hoek-Brown 3)"),
+            std::string::npos)
+      << none;
+  EXPECT_EQ(none.find("Hoek-Brown m_i"), std::string::npos) << none;
 }

@@ -18,6 +18,11 @@ std::string fmt(double v, const char* f = "%.4g") {
   return b;
 }
 
+// A mean with its standard error; a mean over one value (a single valid Brazilian disk) has none.
+std::string mean_se(double m, double se) {
+  return fmt(m) + (std::isfinite(se) ? " ± " + fmt(se) : " (one value: no standard error)");
+}
+
 // A target's tolerance as the tables give it: "5 %" (relative) or "± 0.03" (absolute).
 std::string tolerance_cell(const Target& t) {
   return t.absolute ? "± " + fmt(t.tolerance) : fmt(100 * t.tolerance) + " %";
@@ -110,8 +115,8 @@ std::string validation_table(const ReportInput& r) {
     const double se = value_of(r.validation_se, t.property);
     const int need = seeds_needed(t, value_of(r.validation_sd, t.property));
     s += "| " + t.property + " | " + fmt(t.value) + " | " + tolerance_cell(t) + " | " +
-         fmt(value_of(r.outcome->measured, t.property)) + " ± " + fmt(value_of(r.se, t.property)) +
-         " | " + fmt(m) + " ± " + fmt(se) + " | " + fmt(t.error(m), "%+.2f") + " | " +
+         mean_se(value_of(r.outcome->measured, t.property), value_of(r.se, t.property)) + " | " +
+         mean_se(m, se) + " | " + fmt(t.error(m), "%+.2f") + " | " +
          (std::abs(t.error(m)) <= 1 ? "yes" : "**no**") + " | ";
     s += need < 0
              ? "?"

@@ -14,10 +14,9 @@ double binomial_upper_tail(int k, int n, double p) {
   if (k > n)
     return 0;
   double sum = 0; // the terms in logs: n reaches thousands of cracks
-  const double lp = std::log(p), lq = std::log1p(-p);
+  const double lp = std::log(p), lq = std::log1p(-p), ln_n = std::lgamma(n + 1.0);
   for (int i = k; i <= n; ++i)
-    sum += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) +
-                    i * lp + (n - i) * lq);
+    sum += std::exp(ln_n - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * lp + (n - i) * lq);
   return std::min(1.0, sum);
 }
 
