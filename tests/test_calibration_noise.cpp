@@ -2,6 +2,7 @@
 // errors and the seeds a target needs, fresh validation seeds, and the fitted parameters'
 // uncertainty and identifiability (lab/calibration/noise.*).
 #include "lab/calibration/noise.hpp"
+#include "lab/calibration/report.hpp"
 
 #include <gtest/gtest.h>
 
@@ -172,4 +173,46 @@ TEST(CalibrationNoise, TheStagesAddSeedsWhereTheNoiseHidesAMissInsteadOfStepping
       calibrate({{"emod", Role::Modulus, 1e9, 1e12, 1.3 * right}}, targets, evaluate, budget, add);
   EXPECT_EQ(rock.seeds, 3);
   EXPECT_NEAR(out.params[0].value / right, 1 / 1.042, 0.01);
+}
+
+TEST(CalibrationReport, ATargetNoSeedMeasuredReadsNotMeasuredNotNan) {
+  // The Berea card's validation: every Brazilian disk on its curved jaws started at a jaw (not
+  // valid), so no seed measured the BTS. The row says so instead of "nan ± nan | +inf", and names
+  // no seed count (more seeds of the same disk would not measure it); a mean over a single value
+  // (one valid disk) has no standard error and says that.
+  CalibrationFile c;
+  c.name = "berea";
+  c.file = "berea.json";
+  c.material_file = "berea_fj_3d.json";
+  c.targets = {{"ucs_Pa", 4e7, 0.05, false}, {"bts_Pa", 4e6, 0.25, false}};
+  Outcome out;
+  const double nan = std::nan("");
+  out.measured = {{"ucs_Pa", 4.19e7}, {"bts_Pa", nan}};
+  ReportInput r;
+  r.file = &c;
+  r.outcome = &out;
+  r.seeds = 3;
+  r.sd = {{"ucs_Pa", 1.36e6}, {"bts_Pa", nan}};
+  r.se = {{"ucs_Pa", 7.9e5}, {"bts_Pa", nan}};
+  r.rejected = 3;
+  r.validation_rejected = 6;
+  r.validation_seeds = {1001, 1002, 1003, 1004, 1005, 1006};
+  r.validation_mean = {{"ucs_Pa", 4.072e7}, {"bts_Pa", nan}};
+  r.validation_sd = {{"ucs_Pa", 8.4e5}, {"bts_Pa", nan}};
+  r.validation_se = {{"ucs_Pa", 3.4e5}, {"bts_Pa", nan}};
+  const std::string md = report_md(r);
+  EXPECT_NE(md.find("| bts_Pa | 4e+06 | 25 % | not measured | not measured | – | **no** | – (no "
+                    "seed measured it) |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| ucs_Pa | 4e+07 | 5 % | 4.19e+07 ± 7.9e+05 | 4.072e+07 ± 3.4e+05 | +0.36 | "
+                    "yes |"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("| bts_Pa | 4e+06 | 25 % | not measured | – |"), std::string::npos) << md;
+  EXPECT_EQ(md.find("nan"), std::string::npos) << md;
+  EXPECT_NE(md.find("6 of 6 validation seeds"), std::string::npos) << md;
+  r.se["ucs_Pa"] = nan; // one tuned seed
+  EXPECT_NE(report_md(r).find("| 4.19e+07 (one value: no standard error) |"), std::string::npos)
+      << report_md(r);
 }

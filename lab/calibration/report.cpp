@@ -20,6 +20,8 @@ std::string fmt(double v, const char* f = "%.4g") {
 
 // A mean with its standard error; a mean over one value (a single valid Brazilian disk) has none.
 std::string mean_se(double m, double se) {
+  if (!std::isfinite(m))
+    return "not measured";
   return fmt(m) + (std::isfinite(se) ? " ± " + fmt(se) : " (one value: no standard error)");
 }
 
@@ -36,8 +38,11 @@ std::string targets_table(const ReportInput& r) {
     const double m = value_of(r.outcome->measured, t.property);
     s += "| " + t.property + " | " + fmt(t.value) + " | ";
     s += tolerance_cell(t);
-    s +=
-        " | " + fmt(m) + " ± " + fmt(value_of(r.sd, t.property)) + " | " + fmt(t.error(m)) + " |\n";
+    s += " | " +
+         (std::isfinite(m)
+              ? fmt(m) + " ± " + fmt(value_of(r.sd, t.property)) + " | " + fmt(t.error(m))
+              : std::string("not measured | –")) +
+         " |\n";
   }
   return s;
 }
@@ -56,7 +61,7 @@ std::string params_table(const ReportInput& r) {
 std::string sensitivity_table(const ReportInput& r) {
   const CalibrationFile& c = *r.file;
   const Sensitivity& sv = r.sensitivity;
-  if (sv.per.size() != c.params.size())
+  if (c.params.empty() || sv.per.size() != c.params.size())
     return "No sensitivity table (`\"budget\": {\"sensitivity\": false}`, or the campaign "
            "stopped before it).\n";
   std::string s = "Sensitivity at the optimum: d ln(property) / d ln(parameter), from one run per "
@@ -85,7 +90,8 @@ std::string sensitivity_table(const ReportInput& r) {
   for (const Target& t : c.targets) {
     const double m = value_of(val ? r.validation_mean : r.outcome->measured, t.property),
                  sd = value_of(val ? r.validation_sd : r.sd, t.property);
-    s.append(" *").append(fmt(std::abs(sd / m) / 0.1, "%.2f")).append("* |");
+    const double spread = std::abs(sd / m) / 0.1;
+    s.append(std::isfinite(spread) ? " *" + fmt(spread, "%.2f") + "* |" : " – |");
   }
   return s + "\n\nAn entry smaller than the last row's can be the packing's noise: a different "
              "packing changes the property by that much at the same parameters.\n";
@@ -116,9 +122,12 @@ std::string validation_table(const ReportInput& r) {
     const int need = seeds_needed(t, value_of(r.validation_sd, t.property));
     s += "| " + t.property + " | " + fmt(t.value) + " | " + tolerance_cell(t) + " | " +
          mean_se(value_of(r.outcome->measured, t.property), value_of(r.se, t.property)) + " | " +
-         mean_se(m, se) + " | " + fmt(t.error(m), "%+.2f") + " | " +
+         mean_se(m, se) + " | " + (std::isfinite(m) ? fmt(t.error(m), "%+.2f") : "–") + " | " +
          (std::abs(t.error(m)) <= 1 ? "yes" : "**no**") + " | ";
-    s += need < 0
+    // A target no validation seed measured (every Brazilian disk not valid) has no scatter to
+    // count seeds from: more seeds of the same disk would not measure it.
+    s += !std::isfinite(m) ? "– (no seed measured it)"
+         : need < 0
              ? "?"
              : std::to_string(need) + (se > 0.5 * tolerance_in_units(t) ? " (more than run)" : "");
     s += " |\n";
@@ -137,7 +146,7 @@ std::string validation_table(const ReportInput& r) {
 // there are any: more seeds, a better estimate).
 std::string uncertainty_table(const ReportInput& r) {
   const CalibrationFile& c = *r.file;
-  if (r.sensitivity.per.size() != c.params.size())
+  if (c.params.empty() || r.sensitivity.per.size() != c.params.size())
     return "No parameter uncertainty (it needs the sensitivity table).\n";
   const bool val = !r.validation_seeds.empty();
   std::vector<double> rel;
