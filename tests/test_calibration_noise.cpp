@@ -212,6 +212,8 @@ TEST(CalibrationReport, ATargetNoSeedMeasuredReadsNotMeasuredNotNan) {
   EXPECT_NE(md.find("| bts_Pa | 4e+06 | 25 % | not measured | – |"), std::string::npos) << md;
   EXPECT_EQ(md.find("nan"), std::string::npos) << md;
   EXPECT_NE(md.find("6 of 6 validation seeds"), std::string::npos) << md;
+  // No free parameter: no uncertainty to report, and no matrix to decompose (this crashed).
+  EXPECT_TRUE(parameter_uncertainty({}, {0.02, 0.05}).empty());
   r.se["ucs_Pa"] = nan; // one tuned seed
   EXPECT_NE(report_md(r).find("| 4.19e+07 (one value: no standard error) |"), std::string::npos)
       << report_md(r);

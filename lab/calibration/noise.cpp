@@ -67,6 +67,8 @@ std::vector<ParamUncertainty> parameter_uncertainty(const std::vector<std::vecto
       rows.push_back(j);
   }
   std::vector<ParamUncertainty> out(np);
+  if (np == 0)
+    return out; // no free parameter: nothing to be uncertain about (and no matrix to decompose)
   const double inf = std::numeric_limits<double>::infinity();
   if (rows.empty()) {
     for (ParamUncertainty& u : out)

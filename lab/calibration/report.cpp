@@ -25,6 +25,17 @@ std::string mean_se(double m, double se) {
   return fmt(m) + (std::isfinite(se) ? " ± " + fmt(se) : " (one value: no standard error)");
 }
 
+// A target's error in tolerances, "–" where nothing measured it.
+std::string error_cell(const Target& t, double m, const char* f) {
+  return std::isfinite(m) ? fmt(t.error(m), f) : "–";
+}
+
+// The sensitivity table ran for this file's free parameters (one row per parameter); the
+// parameter-uncertainty table is built from it.
+bool has_sensitivity(const ReportInput& r) {
+  return !r.file->params.empty() && r.sensitivity.per.size() == r.file->params.size();
+}
+
 // A target's tolerance as the tables give it: "5 %" (relative) or "± 0.03" (absolute).
 std::string tolerance_cell(const Target& t) {
   return t.absolute ? "± " + fmt(t.tolerance) : fmt(100 * t.tolerance) + " %";
@@ -39,10 +50,9 @@ std::string targets_table(const ReportInput& r) {
     s += "| " + t.property + " | " + fmt(t.value) + " | ";
     s += tolerance_cell(t);
     s += " | " +
-         (std::isfinite(m)
-              ? fmt(m) + " ± " + fmt(value_of(r.sd, t.property)) + " | " + fmt(t.error(m))
-              : std::string("not measured | –")) +
-         " |\n";
+         (std::isfinite(m) ? fmt(m) + " ± " + fmt(value_of(r.sd, t.property))
+                           : std::string("not measured")) +
+         " | " + error_cell(t, m, "%.4g") + " |\n";
   }
   return s;
 }
@@ -61,7 +71,7 @@ std::string params_table(const ReportInput& r) {
 std::string sensitivity_table(const ReportInput& r) {
   const CalibrationFile& c = *r.file;
   const Sensitivity& sv = r.sensitivity;
-  if (c.params.empty() || sv.per.size() != c.params.size())
+  if (!has_sensitivity(r))
     return "No sensitivity table (`\"budget\": {\"sensitivity\": false}`, or the campaign "
            "stopped before it).\n";
   std::string s = "Sensitivity at the optimum: d ln(property) / d ln(parameter), from one run per "
@@ -122,7 +132,7 @@ std::string validation_table(const ReportInput& r) {
     const int need = seeds_needed(t, value_of(r.validation_sd, t.property));
     s += "| " + t.property + " | " + fmt(t.value) + " | " + tolerance_cell(t) + " | " +
          mean_se(value_of(r.outcome->measured, t.property), value_of(r.se, t.property)) + " | " +
-         mean_se(m, se) + " | " + (std::isfinite(m) ? fmt(t.error(m), "%+.2f") : "–") + " | " +
+         mean_se(m, se) + " | " + error_cell(t, m, "%+.2f") + " | " +
          (std::abs(t.error(m)) <= 1 ? "yes" : "**no**") + " | ";
     // A target no validation seed measured (every Brazilian disk not valid) has no scatter to
     // count seeds from: more seeds of the same disk would not measure it.
@@ -146,7 +156,7 @@ std::string validation_table(const ReportInput& r) {
 // there are any: more seeds, a better estimate).
 std::string uncertainty_table(const ReportInput& r) {
   const CalibrationFile& c = *r.file;
-  if (c.params.empty() || r.sensitivity.per.size() != c.params.size())
+  if (!has_sensitivity(r))
     return "No parameter uncertainty (it needs the sensitivity table).\n";
   const bool val = !r.validation_seeds.empty();
   std::vector<double> rel;
