@@ -135,16 +135,18 @@ std::string validation_table(const ReportInput& r) {
          mean_se(m, se) + " | " + error_cell(t, m, "%+.2f") + " | " +
          (std::abs(t.error(m)) <= 1 ? "yes" : "**no**") + " | ";
     // A target no validation seed measured (every Brazilian disk not valid) has no scatter to
-    // count seeds from: more seeds of the same disk would not measure it.
-    s += !std::isfinite(m) ? "– (no seed measured it)"
+    // count seeds from: more seeds of the same disk would not measure it, another loading of the
+    // disk or a finer one (more grains across) might.
+    s += !std::isfinite(m) ? "– (no seed measured it: more seeds of this test would not; it needs "
+                             "a loading or a resolution whose disks split at the centre)"
          : need < 0
              ? "?"
              : std::to_string(need) + (se > 0.5 * tolerance_in_units(t) ? " (more than run)" : "");
     s += " |\n";
   }
   if (r.rejected + r.validation_rejected > 0)
-    s += "\nBrazilian disks left out of the means (their fracture started at a platen: not valid, "
-         "ISRM): " +
+    s += "\nBrazilian disks left out of the means (not valid, ISRM: their fracture started at a "
+         "platen, or they failed without a split): " +
          std::to_string(r.rejected) + " of " + std::to_string(r.seeds) + " tuned, " +
          std::to_string(r.validation_rejected) + " of " + std::to_string(nv) +
          " validation seeds.\n";
