@@ -219,3 +219,24 @@ TEST(CalibrationReport, ATargetNoSeedMeasuredReadsNotMeasuredNotNan) {
   EXPECT_NE(report_md(r).find("| 4.19e+07 (one value: no standard error) |"), std::string::npos)
       << report_md(r);
 }
+
+TEST(CalibrationReport, ConvergencePlotShowsTheFreshSeedsAndWholeEvaluations) {
+  // A validation-only campaign (one evaluation) drew its x axis 1.0-2.0 in steps of 0.2 and left
+  // out both the fresh seeds and a target no seed measured. The fresh seeds' means are now one
+  // more point after the last evaluation, the axis counts whole evaluations, and an unmeasured
+  // target says so in the legend.
+  CalibrationFile c;
+  c.name = "berea";
+  c.targets = {{"ucs_Pa", 4e7, 0.05, false}, {"bts_Pa", 4e6, 0.25, false}};
+  Outcome out;
+  const double nan = std::nan("");
+  out.history.push_back({1, Stage::Final, {}, {{"ucs_Pa", 4.19e7}, {"bts_Pa", nan}}});
+  const Measured fresh = {{"ucs_Pa", 4.072e7}, {"bts_Pa", nan}};
+  const std::string svg = convergence_svg(c, out, &fresh, 6);
+  EXPECT_NE(svg.find("fresh seeds (6)"), std::string::npos) << svg;
+  EXPECT_NE(svg.find("bts_Pa (not measured)"), std::string::npos) << svg;
+  EXPECT_EQ(svg.find(">1.2<"), std::string::npos) << svg; // no fractional evaluation ticks
+  EXPECT_NE(svg.find(">2<"), std::string::npos) << svg;   // the fresh seeds' point
+  const std::string without = convergence_svg(c, out);
+  EXPECT_EQ(without.find("fresh seeds"), std::string::npos);
+}

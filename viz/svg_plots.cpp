@@ -56,6 +56,7 @@ std::string tick_label(double v, int digits) {
 struct Range1 {
   double lo = 1e300, hi = -1e300, step = 1;
   bool log = false;
+  bool whole = false; ///< ticks on whole numbers only (a count: evaluations, seeds)
   void add(double v) {
     if (std::isfinite(v)) {
       lo = std::min(lo, v);
@@ -68,6 +69,8 @@ struct Range1 {
     if (hi - lo <= 0)
       hi = lo + 1;
     step = log ? std::max(1.0, std::ceil((hi - lo) / 8 - 1e-9)) : tick_step(hi - lo);
+    if (whole)
+      step = std::max(1.0, std::round(step));
     lo = std::floor(lo / step + 1e-9) * step;
     hi = std::ceil(hi / step - 1e-9) * step;
   }
@@ -269,7 +272,8 @@ std::string series_svg(const PlotFrame& f, const PlotSeries& p) {
 std::string line_plot_svg(const std::string& title, const std::string& xlabel,
                           const std::string& ylabel, const std::string& y2label,
                           const std::vector<PlotSeries>& series_in,
-                          const std::vector<PlotMarker>& markers_in, double y_top, bool log_y) {
+                          const std::vector<PlotMarker>& markers_in, double y_top, bool log_y,
+                          bool whole_x) {
   std::vector<PlotSeries> logged;
   std::vector<PlotMarker> markers = markers_in;
   if (log_y)
@@ -277,6 +281,7 @@ std::string line_plot_svg(const std::string& title, const std::string& xlabel,
   const std::vector<PlotSeries>& series = log_y ? logged : series_in;
   PlotFrame f;
   f.ry.log = log_y;
+  f.rx.whole = whole_x;
   f.R = y2label.empty() ? 30 : 80;
   bool has2 = false;
   for (const PlotSeries& p : series)

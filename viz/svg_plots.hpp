@@ -26,11 +26,12 @@ struct PlotMarker {
 /// A line plot with up to two y axes. Returns the SVG text. The left axis reaches at least
 /// `y_top` when it is finite (room above the data, e.g. for the legend); with `log_y` it is
 /// logarithmic (ticks on whole decades; values <= 0 are not drawn, markers there sit on the axis).
+/// `whole_x`: the x axis counts something (evaluations): its ticks fall on whole numbers only.
 std::string line_plot_svg(const std::string& title, const std::string& xlabel,
                           const std::string& ylabel, const std::string& y2label,
                           const std::vector<PlotSeries>& series,
                           const std::vector<PlotMarker>& markers = {}, double y_top = NAN,
-                          bool log_y = false);
+                          bool log_y = false, bool whole_x = false);
 
 /// The cracks of a snapshot over its grains: 2D as it is; 3D a central section seen along
 /// `depth_axis` (1: y, x right and z up; 2: z, x right and y up — a Brazilian disk's faces),

@@ -182,7 +182,8 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   const fs::path out(o.out_dir);
   write_text_file(out / "card.json", card.dump(2) + "\n");
   write_text_file(out / "convergence.csv", convergence_csv(c, cs.outcome));
-  write_svg_and_png(out / "convergence.svg", convergence_svg(c, cs.outcome));
+  write_svg_and_png(out / "convergence.svg",
+                    convergence_svg(c, cs.outcome, &r.validation_mean, r.validation_seeds.size()));
   write_text_file(out / "report.md", report_md(r));
   return cs;
 }

@@ -223,7 +223,8 @@ std::string convergence_csv(const CalibrationFile& c, const Outcome& out) {
   return s;
 }
 
-std::string convergence_svg(const CalibrationFile& c, const Outcome& out) {
+std::string convergence_svg(const CalibrationFile& c, const Outcome& out,
+                            const Measured* validation, std::size_t validation_seeds) {
   // |error| in tolerances per target on a log axis, so that a first guess 50 tolerances off and a
   // converged 0.1 both stay legible (a linear axis clipped at 5 drew BTS and direct tension on the
   // same point); a target not measured in a stage (e.g. BTS during the UCS-only stages) has no
@@ -231,19 +232,27 @@ std::string convergence_svg(const CalibrationFile& c, const Outcome& out) {
   constexpr double kFloor = 0.01;
   static const char* const colors[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd",
                                        "#ff7f0e", "#8c564b", "#e377c2", "#17becf"};
+  const int last = out.history.empty() ? 0 : out.history.back().evaluation;
+  const bool val = validation && validation_seeds > 0;
   std::vector<PlotSeries> series;
   for (std::size_t k = 0; k < c.targets.size(); ++k) {
     PlotSeries p;
     p.label = c.targets[k].property;
     p.color = colors[k % 8];
     p.dashed = k >= 8;
-    for (const Record& r : out.history) {
-      const double m = value_of(r.measured, c.targets[k].property);
+    auto add = [&](int x, const Measured& measured) {
+      const double m = value_of(measured, c.targets[k].property);
       if (std::isfinite(m)) {
-        p.x.push_back(r.evaluation);
+        p.x.push_back(x);
         p.y.push_back(std::max(kFloor, std::abs(c.targets[k].error(m))));
       }
-    }
+    };
+    for (const Record& r : out.history)
+      add(r.evaluation, r.measured);
+    if (val)
+      add(last + 1, *validation);
+    if (p.x.empty())
+      p.label += " (not measured)";
     series.push_back(p);
   }
   PlotSeries tol{"tolerance (1)", {}, {}, "#000000", true};
@@ -254,9 +263,15 @@ std::string convergence_svg(const CalibrationFile& c, const Outcome& out) {
     if (stages.empty() || stages.back().label != stage_name(r.stage))
       stages.push_back({static_cast<double>(r.evaluation), 0, stage_name(r.stage)});
   }
+  if (val) {
+    tol.x.push_back(last + 1);
+    tol.y.push_back(1);
+    stages.push_back({static_cast<double>(last + 1), 0,
+                      "fresh seeds (" + std::to_string(validation_seeds) + ")"});
+  }
   series.push_back(tol);
   return line_plot_svg("Calibration " + c.name + ": error per target", "evaluation",
-                       "|error| / tolerance (log scale)", "", series, stages, NAN, true);
+                       "|error| / tolerance (log scale)", "", series, stages, NAN, true, true);
 }
 
 std::string report_md(const ReportInput& r) {

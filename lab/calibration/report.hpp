@@ -39,7 +39,11 @@ struct ReportInput {
 /// no value, NaN, counts as infinite).
 double worst_error(const std::vector<Target>& targets, const Measured& m);
 std::string convergence_csv(const CalibrationFile& c, const Outcome& out);
-std::string convergence_svg(const CalibrationFile& c, const Outcome& out);
+/// Each target's |error| in tolerances against the evaluation; with `validation` (the fitted
+/// card's means on `validation_seeds` fresh seeds) one more point after the last evaluation, so
+/// the step from the tuned seeds to fresh ones shows.
+std::string convergence_svg(const CalibrationFile& c, const Outcome& out,
+                            const Measured* validation = nullptr, std::size_t validation_seeds = 0);
 std::string report_md(const ReportInput& r);
 
 } // namespace rocklab::calibration
