@@ -18,11 +18,15 @@ std::string fmt(double v, const char* f = "%.4g") {
   return b;
 }
 
+// A measured mean's cell, `text`, or "not measured" where no seed measured it.
+std::string measured_cell(double m, const std::string& text) {
+  return std::isfinite(m) ? text : "not measured";
+}
+
 // A mean with its standard error; a mean over one value (a single valid Brazilian disk) has none.
 std::string mean_se(double m, double se) {
-  if (!std::isfinite(m))
-    return "not measured";
-  return fmt(m) + (std::isfinite(se) ? " ± " + fmt(se) : " (one value: no standard error)");
+  return measured_cell(
+      m, fmt(m) + (std::isfinite(se) ? " ± " + fmt(se) : " (one value: no standard error)"));
 }
 
 // A target's error in tolerances, "–" where nothing measured it.
@@ -49,10 +53,8 @@ std::string targets_table(const ReportInput& r) {
     const double m = value_of(r.outcome->measured, t.property);
     s += "| " + t.property + " | " + fmt(t.value) + " | ";
     s += tolerance_cell(t);
-    s += " | " +
-         (std::isfinite(m) ? fmt(m) + " ± " + fmt(value_of(r.sd, t.property))
-                           : std::string("not measured")) +
-         " | " + error_cell(t, m, "%.4g") + " |\n";
+    s += " | " + measured_cell(m, fmt(m) + " ± " + fmt(value_of(r.sd, t.property))) + " | " +
+         error_cell(t, m, "%.4g") + " |\n";
   }
   return s;
 }
