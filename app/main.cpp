@@ -83,16 +83,9 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
     throw std::runtime_error("interrupted; no specimen was written");
   const nlohmann::json report = g.report.to_json();
   const nlohmann::json meta = rocklab::specimen_meta(card, g.report);
-  // The report first (atomically), then the specimen: a specimen never lacks its report.
+  rocklab::save_specimen(*g.model, out, rocklab::specimen_meta(card, g.report),
+                         g.report.to_json());
   const std::string report_file = out + ".report.json";
-  rocklab::write_text_file(report_file + ".partial", report.dump(1) + "\n");
-  try {
-    rocklab::save_model(*g.model, out, meta);
-  } catch (...) {
-    std::remove((report_file + ".partial").c_str());
-    throw;
-  }
-  std::rename((report_file + ".partial").c_str(), report_file.c_str());
   if (!quiet) {
     const rocklab::GenesisReport& r = g.report;
     std::printf("material     %s (%s, hash %s)\n", card.name.c_str(), material_file.c_str(),

@@ -276,20 +276,56 @@ CalibrationFile load_calibration(const std::string& path) {
   return c;
 }
 
+namespace {
+
+// Set the card value at "section.key" to `v`: a {"mean", "sd"} distribution keeps its
+// coefficient of variation.
+void set_value(nlohmann::json& card, const std::string& path, double v) {
+  nlohmann::json* x = &value_at(card, path);
+  if (x->is_object() && x->contains("mean")) {
+    const double mean = (*x)["mean"].get<double>();
+    if (x->contains("sd") && mean != 0)
+      (*x)["sd"] = (*x)["sd"].get<double>() * v / mean;
+    (*x)["mean"] = v;
+  } else {
+    *x = v;
+  }
+}
+
+// A free gapped or slit fraction takes its share from the bonded one (the three sum to 1).
+void rebalance_fraction(nlohmann::json& card, const std::string& path) {
+  if (const std::string types = fraction_parent(path); !types.empty()) {
+    nlohmann::json& t = value_at(card, types);
+    t["bonded"] = 1 - t.value("gapped", 0.0) - t.value("slit", 0.0);
+  }
+}
+
+} // namespace
+
+nlohmann::json override_card(const nlohmann::json& card,
+                             const std::vector<std::pair<std::string, nlohmann::json>>& overrides,
+                             const std::string& where) {
+  nlohmann::json out = card;
+  for (const auto& [path, v] : overrides) {
+    const std::size_t dot = path.rfind('.');
+    const std::string parent = dot == std::string::npos ? "" : path.substr(0, dot);
+    const nlohmann::json* p = parent.empty() ? &out : card_value(out, parent);
+    if (path.empty() || path.back() == '.' || !p || !p->is_object())
+      throw InputError(where + ": override '" + path + "': the card has no section \"" + parent +
+                       "\" (write \"section.key\", e.g. \"flatjoint.fj_ten\")");
+    if (v.is_number() && !v.is_boolean())
+      set_value(out, path, v.get<double>());
+    else
+      value_at(out, path) = v;
+    rebalance_fraction(out, path);
+  }
+  return out;
+}
+
 nlohmann::json apply_params(const nlohmann::json& card, const std::vector<CardParam>& params,
                             const std::vector<double>& values) {
   nlohmann::json out = card;
-  auto set = [&](const std::string& path, double v) {
-    nlohmann::json* x = &value_at(out, path);
-    if (x->is_object()) { // a distribution keeps its coefficient of variation
-      const double mean = (*x)["mean"].get<double>();
-      if (x->contains("sd") && mean != 0)
-        (*x)["sd"] = (*x)["sd"].get<double>() * v / mean;
-      (*x)["mean"] = v;
-    } else {
-      *x = v;
-    }
-  };
+  auto set = [&](const std::string& path, double v) { set_value(out, path, v); };
   for (int pass = 0; pass < 2; ++pass) // plain values first, then ratios over them
     for (std::size_t i = 0; i < params.size(); ++i) {
       const CardParam& p = params[i];
@@ -297,12 +333,8 @@ nlohmann::json apply_params(const nlohmann::json& card, const std::vector<CardPa
         continue;
       set(p.path, pass == 0 ? values[i] : values[i] * number_of(*card_value(out, p.over)));
     }
-  // A free gapped or slit fraction takes its share from the bonded one (the three sum to 1).
   for (const CardParam& p : params)
-    if (const std::string types = fraction_parent(p.path); !types.empty()) {
-      nlohmann::json& t = value_at(out, types);
-      t["bonded"] = 1 - t.value("gapped", 0.0) - t.value("slit", 0.0);
-    }
+    rebalance_fraction(out, p.path);
   return out;
 }
 

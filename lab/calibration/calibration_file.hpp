@@ -51,4 +51,13 @@ struct TargetNeed {
 };
 const std::vector<TargetNeed>& target_needs();
 
+/// A card with `overrides` ("section.key" -> value) set the way a calibration sets its
+/// parameters: a number on a {"mean", "sd"} strength keeps its coefficient of variation, a slit or
+/// gapped fraction takes its share from the bonded one, anything else replaces the value. A key
+/// whose section the card lacks is an InputError naming `where` and the key; the card's own
+/// checks judge the values when it is loaded.
+nlohmann::json override_card(const nlohmann::json& card,
+                             const std::vector<std::pair<std::string, nlohmann::json>>& overrides,
+                             const std::string& where);
+
 } // namespace rocklab::calibration

@@ -133,7 +133,23 @@ std::string not_an_input_file(const std::string& path) {
   return "";
 }
 
+namespace {
+// The inputs given as text on this thread, latest last.
+thread_local std::vector<std::pair<std::string, std::string>> t_input_texts;
+} // namespace
+
+InputText::InputText(std::string name, std::string text) {
+  t_input_texts.emplace_back(std::move(name), std::move(text));
+}
+
+InputText::~InputText() {
+  t_input_texts.pop_back();
+}
+
 std::string read_input_text(const std::string& path) {
+  for (auto it = t_input_texts.rbegin(); it != t_input_texts.rend(); ++it)
+    if (it->first == path)
+      return it->second;
   if (const std::string why = not_an_input_file(path); !why.empty())
     throw InputError(path + ": " + why);
   std::ifstream in(path, std::ios::binary);

@@ -39,7 +39,21 @@ struct Range {
 /// Why `path` cannot be an input file (a directory, a device or a socket), or "".
 std::string not_an_input_file(const std::string& path);
 /// The bytes of an input file; a directory, a device or an unreadable file is an input error.
+/// A name given to an InputText living on this thread reads as its text instead of the disk.
 std::string read_input_text(const std::string& path);
+
+/// An input given as text rather than as a file (the Python module's dict arguments): while it
+/// lives, read_input_text(name) on this thread returns `text`, so every loader reads it as it reads
+/// a file, and its errors name `name`. Relative paths in it resolve against the directory of
+/// `name` (the working directory for a bare name such as "<card dict>"). Names nest: the latest
+/// given wins until it ends. Not shared with other threads or child processes.
+class InputText {
+public:
+  InputText(std::string name, std::string text);
+  ~InputText();
+  InputText(const InputText&) = delete;
+  InputText& operator=(const InputText&) = delete;
+};
 /// Parse a JSON file; syntax errors name the file, line and column. A key given twice in one
 /// object, nesting deeper than 256 levels and (in input files, not in rocklab's own outputs read
 /// back) a null value are input errors naming the key path.

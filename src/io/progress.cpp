@@ -24,11 +24,21 @@ double log_every() {
   }
   return kLogEvery;
 }
+thread_local std::function<void(const ProgressEvent&)> t_sink;
+
 } // namespace
 
+ProgressSink::ProgressSink(std::function<void(const ProgressEvent&)> sink) {
+  t_sink = std::move(sink);
+}
+
+ProgressSink::~ProgressSink() {
+  t_sink = nullptr;
+}
+
 ProgressLine::ProgressLine(std::string tag, bool enabled, int terminal)
-    : tag_(std::move(tag)), enabled_(enabled),
-      terminal_(terminal < 0 ? ::isatty(STDERR_FILENO) != 0 : terminal != 0),
+    : tag_(std::move(tag)), sink_(t_sink), enabled_(enabled),
+      terminal_(sink_ || (terminal < 0 ? ::isatty(STDERR_FILENO) != 0 : terminal != 0)),
       log_every_(log_every()), start_(clock::now()), last_(start_) {}
 
 ProgressLine::~ProgressLine() {
@@ -88,6 +98,10 @@ void ProgressLine::show(const std::string& what, double fraction) {
     const double dt = std::chrono::duration<double>(last_ - ref_time_).count();
     if (fraction < 1 && fraction > ref_fraction_ && dt > 2)
       eta = dt * (1 - fraction) / (fraction - ref_fraction_);
+  }
+  if (sink_) {
+    sink_({tag_, what, fraction, elapsed, eta});
+    return;
   }
   if (terminal_) {
     // One column short of the width: a full-width line makes some terminals wrap at once.

@@ -6,9 +6,27 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <string>
 
 namespace rocklab {
+
+/// One progress line as data: the command's tag, the state, the fraction done (< 0: unknown), the
+/// elapsed and the estimated remaining time [s] (< 0: unknown).
+struct ProgressEvent {
+  std::string tag, what;
+  double fraction = -1, elapsed_s = 0, eta_s = -1;
+};
+
+/// While it lives, the progress lines of this thread go to `sink` instead of stderr, at the
+/// terminal's pace (every 0.5 s after the first second): the Python module's progress callback.
+class ProgressSink {
+public:
+  explicit ProgressSink(std::function<void(const ProgressEvent&)> sink);
+  ~ProgressSink();
+  ProgressSink(const ProgressSink&) = delete;
+  ProgressSink& operator=(const ProgressSink&) = delete;
+};
 
 class ProgressLine {
 public:
@@ -37,6 +55,7 @@ public:
 private:
   using clock = std::chrono::steady_clock;
   std::string tag_;
+  std::function<void(const ProgressEvent&)> sink_; ///< this thread's ProgressSink when made
   bool enabled_;
   bool terminal_;
   double log_every_; ///< [s]

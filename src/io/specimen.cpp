@@ -7,6 +7,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -430,6 +431,19 @@ std::unique_ptr<Model> load_model(const std::string& path, nlohmann::json* meta)
   if (meta)
     *meta = header.value("meta", nlohmann::json::object());
   return m;
+}
+
+void save_specimen(const Model& m, const std::string& path, const nlohmann::json& meta,
+                   const nlohmann::json& report) {
+  const std::string report_file = path + ".report.json";
+  write_text_file(report_file + ".partial", report.dump(1) + "\n");
+  try {
+    save_model(m, path, meta);
+  } catch (...) {
+    std::remove((report_file + ".partial").c_str());
+    throw;
+  }
+  std::rename((report_file + ".partial").c_str(), report_file.c_str());
 }
 
 } // namespace rocklab

@@ -24,6 +24,12 @@ inline constexpr int kSpecimenVersion = 8;
 /// Write atomically (temporary file, then rename). Throws std::runtime_error naming the file.
 void save_model(const Model& m, const std::string& path, const nlohmann::json& meta = {});
 
+/// What `rocklab genesis -o PATH` writes: PATH.report.json (the genesis report) and the specimen
+/// at PATH, the report first, so that a specimen never lacks its report and an error leaves
+/// neither behind.
+void save_specimen(const Model& m, const std::string& path, const nlohmann::json& meta,
+                   const nlohmann::json& report);
+
 /// Read a file written by save_model; `meta` receives the header's "meta" object.
 /// Throws InputError naming the file on a wrong format, version, checksum, truncated body or a
 /// field out of range (an index that names nothing, a flag that is not 0 or 1, ...).
