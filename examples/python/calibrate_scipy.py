@@ -21,7 +21,8 @@ import rocklab
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 CARD = os.path.join(ROOT, "materials", "granite_fj_2d.json")
-SMALL = {"specimen": {"shape": "rectangle", "width": 0.012, "height": 0.024}}
+# The example study's small specimen: 16 mm x 32 mm, about 460 grains, porosity 0.19.
+SMALL = {"specimen": {"shape": "rectangle", "width": 0.016, "height": 0.032}, "porosity": 0.19}
 
 
 def measure(emod, ten, seeds):
@@ -48,18 +49,20 @@ def main(argv=None):
     a = ap.parse_args(argv)
     log = []
 
-    def residuals(x):
-        emod, ten = np.exp(x)
+    start = np.array([1e11, 3.5e7])  # the card's fj_emod and fj_ten [Pa]
+
+    def residuals(x):  # x: log of the parameters over their start values
+        emod, ten = start * np.exp(x)
         e, ucs = measure(emod, ten, a.seeds)
         log.append((emod, ten, e, ucs))
         print("fj_emod %.4g Pa  fj_ten %.4g Pa  ->  E %.4g Pa (%+.1f %%)  UCS %.4g Pa (%+.1f %%)"
               % (emod, ten, e, 100 * (e / a.E - 1), ucs, 100 * (ucs / a.ucs - 1)), flush=True)
         return [e / a.E - 1, ucs / a.ucs - 1]
 
-    start = np.log([1e11, 3.5e7])
-    fit = least_squares(residuals, start, diff_step=0.05, max_nfev=a.max_evaluations,
+    # x starts at 0, so scipy's relative step diff_step * max(1, |x|) is a 5 % change.
+    fit = least_squares(residuals, np.zeros(2), diff_step=0.05, max_nfev=a.max_evaluations,
                         xtol=1e-3, ftol=1e-3)
-    emod, ten = np.exp(fit.x)
+    emod, ten = start * np.exp(fit.x)
     print("fitted fj_emod %.4g Pa, fj_ten %.4g Pa after %d evaluations (%s); residuals %s"
           % (emod, ten, len(log), fit.message, np.round(fit.fun, 4)))
     print("Check the fitted card on seeds it was not fitted on before trusting it.")
