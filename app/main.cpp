@@ -81,10 +81,7 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
   rocklab::GenesisResult g = rocklab::genesis_with_overrides(card, overrides, !quiet, &g_interrupt);
   if (g_interrupt.load())
     throw std::runtime_error("interrupted; no specimen was written");
-  const nlohmann::json report = g.report.to_json();
-  const nlohmann::json meta = rocklab::specimen_meta(card, g.report);
-  rocklab::save_specimen(*g.model, out, rocklab::specimen_meta(card, g.report),
-                         g.report.to_json());
+  rocklab::save_specimen(*g.model, out, rocklab::specimen_meta(card, g.report), g.report.to_json());
   const std::string report_file = out + ".report.json";
   if (!quiet) {
     const rocklab::GenesisReport& r = g.report;

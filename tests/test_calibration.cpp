@@ -704,3 +704,31 @@ TEST(CalibrationCli, MpiRanksReachTheResultOfLocalJobs) {
   EXPECT_GE(std::stoi(m[1]), 6) << "every evaluation runs two replicate suites";
 #endif
 }
+
+TEST(CalibrationFile, OverridesSetTheCardAsACalibrationSetsItsParameters) {
+  const nlohmann::json card = {{"porosity", 0.2},
+                               {"flatjoint",
+                                {{"fj_ten", {{"mean", 2e6}, {"sd", 4e5}}},
+                                 {"types", {{"bonded", 0.9}, {"gapped", 0.0}, {"slit", 0.1}}}}}};
+  const nlohmann::json out = rocklab::calibration::override_card(
+      card,
+      {{"flatjoint.fj_ten", 3e6},
+       {"flatjoint.types.slit", 0.3},
+       {"porosity", 0.25},
+       {"specimen", {{"shape", "disk"}, {"diameter", 0.05}, {"thickness", 0.025}}}},
+      "card.json");
+  EXPECT_EQ(out["flatjoint"]["fj_ten"]["mean"], 3e6);
+  EXPECT_DOUBLE_EQ(out["flatjoint"]["fj_ten"]["sd"].get<double>(), 6e5); // CoV 0.2 kept
+  EXPECT_DOUBLE_EQ(out["flatjoint"]["types"]["bonded"].get<double>(), 0.7);
+  EXPECT_EQ(out["porosity"], 0.25);
+  EXPECT_EQ(out["specimen"]["shape"], "disk");
+  EXPECT_EQ(card["porosity"], 0.2); // the input is untouched
+  try {
+    rocklab::calibration::override_card(card, {{"flatjoin.fj_ten", 1.0}}, "card.json");
+    ADD_FAILURE() << "an override in a section the card lacks was accepted";
+  } catch (const rocklab::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("card.json: override 'flatjoin.fj_ten'"),
+              std::string::npos)
+        << e.what();
+  }
+}

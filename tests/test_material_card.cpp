@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 namespace fs = std::filesystem;
 using namespace rocklab;
@@ -156,4 +157,38 @@ TEST(MaterialCard, FactorsAContactDividesByHaveAPositiveLowerBound) {
   EXPECT_THROW(scene_read<Linear>({{"emod", 1e9}, {"kratio", 1e-9}}, 2), InputError);
   EXPECT_THROW(scene_read<FlatJoint>({{"fj_emod", 1e9}, {"fj_kratio", 1e-300}}, 2), InputError);
   EXPECT_NO_THROW(scene_read<FlatJoint>({{"fj_emod", 1e9}, {"fj_kratio", 0.0}}, 2));
+}
+
+TEST(MaterialCard, AnInputGivenAsTextReadsLikeItsFileAndIsNamedInErrors) {
+  // The Python module's dicts: the text under a name is read by the same loader as a file.
+  const std::string file = test::source_dir() + "/tests/data/lab_2d_fj.json";
+  json card = read_json_file(file);
+  const MaterialCard from_file = load_material_card(file);
+  {
+    const InputText given("<card dict>", card.dump());
+    const MaterialCard from_text = load_material_card("<card dict>");
+    EXPECT_EQ(from_text.name, from_file.name);
+    EXPECT_EQ(from_text.porosity, from_file.porosity);
+    EXPECT_EQ(from_text.fj_ten.mean, from_file.fj_ten.mean);
+    card["porosity"] = 1.5;
+    const InputText inner("<card dict>", card.dump()); // the latest given wins
+    try {
+      load_material_card("<card dict>");
+      ADD_FAILURE() << "a porosity of 1.5 was accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("<card dict>: key 'porosity'", 0), 0u) << e.what();
+    }
+  }
+  // Gone with its scope, and never seen by another thread.
+  EXPECT_THROW(load_material_card("<card dict>"), InputError);
+  const InputText given("<card dict>", read_input_text(file));
+  bool other_thread_threw = false;
+  std::thread([&] {
+    try {
+      read_input_text("<card dict>");
+    } catch (const InputError&) {
+      other_thread_threw = true;
+    }
+  }).join();
+  EXPECT_TRUE(other_thread_threw);
 }
