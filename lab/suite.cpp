@@ -403,10 +403,17 @@ std::string summary_table(const nlohmann::json& sm) {
     t += line;
   }
   const auto& p = sm["properties"];
+  // A BTS only from valid disks: where every disk failed at a platen it is not measured, and
+  // what those disks read is said as such.
+  std::string bts = "BTS " + mpa(p["bts_Pa"], 1e-6) + " MPa";
+  if (!p.value("bts_Pa", nlohmann::json()).is_number() &&
+      p.value("bts_not_valid_Pa", nlohmann::json()).is_number())
+    bts = "BTS not measured (no valid disk; the disks not valid read " +
+          mpa(p["bts_not_valid_Pa"], 1e-6) + " MPa)";
   std::snprintf(line, sizeof line,
-                "E %s GPa   nu %s   UCS %s MPa   BTS %s MPa   direct tension %s MPa   UCS/BTS %s\n",
+                "E %s GPa   nu %s   UCS %s MPa   %s   direct tension %s MPa   UCS/BTS %s\n",
                 mpa(p["youngs_modulus_Pa"], 1e-9).c_str(), mpa(p["poisson_ratio"], 1).c_str(),
-                mpa(p["ucs_Pa"], 1e-6).c_str(), mpa(p["bts_Pa"], 1e-6).c_str(),
+                mpa(p["ucs_Pa"], 1e-6).c_str(), bts.c_str(),
                 mpa(p["direct_tension_Pa"], 1e-6).c_str(), mpa(p["ucs_over_bts"], 1).c_str());
   t += line;
   // The envelope line only where compression peaks at two confinements or more gave one; a

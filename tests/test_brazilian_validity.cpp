@@ -151,13 +151,18 @@ TEST(BrazilianValidity, ASuiteAveragesItsValidDisksAndCountsThemAll) {
                           {"fracture_origin", {{"valid", valid}}}};
   };
   SuiteValues v;
-  bz->add_to_suite(disk(5e6, false), v); // crushed at a platen: its strength stands in, flagged
-  EXPECT_DOUBLE_EQ(v.get("bts_Pa"), 5e6);
+  bz->add_to_suite(disk(5e6, false), v); // crushed at a platen: no BTS, its reading said apart
+  EXPECT_TRUE(std::isnan(v.get("bts_Pa")));
+  EXPECT_DOUBLE_EQ(v.get("bts_not_valid_Pa"), 5e6);
   EXPECT_DOUBLE_EQ(v.get("brazilian_valid"), 0);
+  nlohmann::json props;
+  bz->suite_results(v, props);
+  EXPECT_TRUE(props["bts_Pa"].is_null()); // summary.json: not measured
   bz->add_to_suite(disk(10e6, true), v);
   bz->add_to_suite(disk(12e6, true), v);
   bz->add_to_suite(disk(30e6, false), v);
   EXPECT_DOUBLE_EQ(v.get("bts_Pa"), 11e6); // the valid disks' mean
+  EXPECT_DOUBLE_EQ(v.get("bts_not_valid_Pa"), 17.5e6);
   EXPECT_DOUBLE_EQ(v.get("brazilian_valid"), 0.5);
   EXPECT_DOUBLE_EQ(v.get("brazilian_disks"), 4);
 }
@@ -181,4 +186,50 @@ TEST(FlattenedDisk, TheCentreTensionFactorIsTheSumOfDiametralPointLoads) {
     EXPECT_NEAR(flat_disk_factor(deg * std::numbers::pi / 180), superposed, 1e-9) << deg;
   }
   EXPECT_NEAR(flat_disk_factor(20 * std::numbers::pi / 180), 0.9596, 1e-4);
+}
+
+// The loaded arc (lab/protocols/brazilian_readings.cpp): one contact spreads nothing; a pressure
+// spread evenly over [-a, a] (many equal contacts) reads its own half-width a, wherever its centre
+// lies; two equal contacts at +-b read the uniform load of the same spread, sqrt(3) b. The
+// strength factor at the half-angle asin(a / R) is Hondros' (sin 2a - a) / a.
+TEST(BrazilianReadings, TheLoadedArcIsTheUniformLoadWithTheSameSpread) {
+  ArcSums one;
+  one.add(0.3e-3, 50.0);
+  EXPECT_EQ(one.half_width(), 0.0);
+  ArcSums even;
+  const double a = 2e-3, shift = 0.4e-3;
+  const int n = 2001;
+  for (int i = 0; i < n; ++i)
+    even.add(shift + a * (-1 + 2.0 * (i + 0.5) / n), 3.0);
+  EXPECT_NEAR(even.half_width(), a, 1e-6 * a);
+  ArcSums pair;
+  pair.add(-1e-3, 7.0);
+  pair.add(1e-3, 7.0);
+  EXPECT_NEAR(pair.half_width(), std::sqrt(3.0) * 1e-3, 1e-15);
+  ArcSums none;
+  EXPECT_EQ(none.half_width(), 0.0);
+  // A 26 mm disk loaded over 2a = 40 deg: its centre's tension is 0.84 of the line load's.
+  EXPECT_NEAR(flat_disk_factor(40 * std::numbers::pi / 180), 0.8415, 1e-3);
+}
+
+// The stop rule's watch, fed one reading at a time, finds the same loss as the whole record read
+// at the end, and reports it only once it has lasted `persist` steps.
+TEST(BrazilianReadings, TheTensionWatchFindsTheLossAsTheRecordDoes) {
+  std::vector<TensionReading> r;
+  for (int k = 0; k <= 600; ++k) { // climbing at 0.6, a loss to 0.3 from step 3000 on
+    const double load = 1e6 + 1e4 * std::min(k, 400);
+    r.push_back({10 * k, load, k < 300 ? 0.6 : 0.3});
+  }
+  TensionWatch w(0.6, 0.3, 2e6, 1000);
+  std::int64_t seen = -1;
+  for (const TensionReading& x : r) {
+    w.add(x);
+    if (seen < 0 && w.lost().step >= 0)
+      seen = x.step;
+  }
+  const TensionLoss whole = tension_loss(r, 0.6, 0.3, 2e6, 1000);
+  EXPECT_EQ(whole.step, 3000);
+  EXPECT_EQ(w.result().step, whole.step);
+  EXPECT_DOUBLE_EQ(w.result().reference, whole.reference);
+  EXPECT_EQ(seen, 4000); // known once it lasted 1000 steps
 }

@@ -40,6 +40,11 @@ Measured synthetic_rock(const std::vector<double>& v, double noise, std::mt19937
   m["direct_tension_Pa"] = nz(ten * 0.9 * (1 - 0.3 * f));
   m["ucs_over_bts"] = m[kUcs] / m["bts_Pa"];
   m["crack_initiation_over_ucs"] = nz(0.25 + 0.5 * f + 0.005 * r);
+  // Each mean's standard error (the noise's size: a mean over seeds with that scatter), so that a
+  // target within its tolerance is confirmed (stages.hpp, target_confirmed).
+  for (const std::string k : {kYoungs, kPoisson, kUcs, "bts_Pa", "direct_tension_Pa",
+                              "ucs_over_bts", "crack_initiation_over_ucs"})
+    m[se_key(k)] = noise * std::abs(m[k]);
   return m;
 }
 

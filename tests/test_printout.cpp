@@ -117,6 +117,18 @@ TEST(Printout, EveryDeclaredSuitePropertyIsAColumnOfTheSuiteTables) {
   for (std::size_t k = 9; k < cols.size(); ++k)
     EXPECT_NE(table.find(cols[k] + " 1.5"), std::string::npos) << cols[k] << "\n" << table;
   EXPECT_NE(table.find("E 1.5e-09 GPa"), std::string::npos) << table;
+  EXPECT_NE(table.find("BTS 1.5e-06 MPa"), std::string::npos) << table;
+  // No valid disk: the BTS is not measured, and what the disks that were not valid read is said as
+  // such, not as the BTS.
+  json invalid = summary;
+  invalid["properties"]["bts_Pa"] = nullptr;
+  invalid["properties"]["ucs_over_bts"] = nullptr;
+  invalid["properties"]["bts_not_valid_Pa"] = 11.21e6;
+  const std::string no_bts = summary_table(invalid);
+  EXPECT_NE(no_bts.find("BTS not measured (no valid disk; the disks not valid read 11.21 MPa)"),
+            std::string::npos)
+      << no_bts;
+  EXPECT_NE(no_bts.find("UCS/BTS -"), std::string::npos) << no_bts;
   // The envelope's m_i comes with the sigma3 range it was fitted over and its fit error.
   EXPECT_NE(table.find("(3 points, sigma3 up to - UCS, fit error -)"), std::string::npos) << table;
   json fitted = summary;

@@ -248,6 +248,9 @@ CalibrationFile load_calibration(const std::string& path) {
   }
   if (c.seeds.empty())
     c.seeds = {1, 2, 3};
+  // Per-seed results merged and kept (lab/calibration/seed_rows.hpp); default OUTDIR/seeds.csv.
+  if (top.has("seeds_file"))
+    c.seeds_file = resolve(path, top.string("seeds_file"));
   JsonObject b = top.optional_object("budget");
   c.budget.elastic = static_cast<int>(b.integer("elastic", 0, 100, c.budget.elastic));
   c.budget.strength = static_cast<int>(b.integer("strength", 0, 100, c.budget.strength));
@@ -268,6 +271,8 @@ CalibrationFile load_calibration(const std::string& path) {
   if (c.budget.validation_max > 0 && c.budget.validation_max < c.budget.validation_min)
     b.fail("validation_max", "must be 0 (no validation) or at least budget.validation_min (" +
                                  std::to_string(c.budget.validation_min) + ")");
+  c.budget.validation_rounds =
+      static_cast<int>(b.integer("validation_rounds", 1, 20, c.budget.validation_rounds));
   c.budget.validation_first =
       static_cast<std::uint64_t>(b.integer("validation_first", 0, std::int64_t{1} << 50,
                                            static_cast<std::int64_t>(c.budget.validation_first)));

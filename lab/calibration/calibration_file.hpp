@@ -30,6 +30,8 @@ struct CalibrationFile {
   std::vector<CardParam> params;
   nlohmann::json tests = nlohmann::json::array(); ///< suite tests (docs/protocol-format.md)
   std::vector<std::uint64_t> seeds;               ///< replicate specimens per evaluation
+  /// Per-seed results read before and written after each replicate ("" : OUTDIR/seeds.csv)
+  std::string seeds_file;
   Budget budget;
 };
 

@@ -3,6 +3,7 @@
 #include "io/output_dir.hpp"
 #include "lab/calibration/noise.hpp"
 #include "lab/calibration/report.hpp"
+#include "lab/calibration/rounds.hpp"
 #include "viz/svg_png.hpp"
 
 #include <algorithm>
@@ -76,25 +77,6 @@ void print_progress(const std::string& what, const CalibrationFile& c, const Eva
                std::chrono::duration<double>(took).count(), cpu);
 }
 
-// The fitted card on fresh seeds it was never tuned on: as many as make each target's standard
-// error half its tolerance (from the tuned seeds' scatter), within the budget's bounds.
-void validate(Evaluator& ev, const CalibrationFile& c, const std::vector<double>& values,
-              ReportInput& r, bool talk) {
-  const int n = validation_seed_count(c.targets, known_scatter(r.sd, r.se), c.budget.validation_min,
-                                      c.budget.validation_max);
-  r.validation_seeds = fresh_seeds(c.budget.validation_first, n, ev.seeds());
-  if (talk)
-    std::fprintf(stderr, "[rocklab calibrate] validation: the fitted card on %d fresh seeds\n", n);
-  const auto t = std::chrono::steady_clock::now();
-  const Evaluation v = ev.run_on(values, Stage::Final, r.validation_seeds);
-  if (talk)
-    print_progress("validation", c, v, std::chrono::steady_clock::now() - t);
-  r.validation_rejected = v.rejected_disks;
-  r.validation_mean = v.mean;
-  r.validation_sd = v.sd;
-  r.validation_se = v.se;
-}
-
 } // namespace
 
 CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o) {
@@ -123,8 +105,28 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
     Measured m = last.mean;
     for (const auto& [k, se] : last.se)
       m[se_key(k)] = se;
+    m[kSeedCount] = static_cast<double>(last.folders.size());
     return m;
   };
+  // The fitted card on fresh seeds it was never tuned on (nor an earlier validation used): as
+  // many as make each target's standard error half its tolerance (from the last evaluation's
+  // scatter), within the budget's bounds.
+  const Validate validate = [&](const std::vector<double>& values) {
+    ValidationRun v;
+    const int n = validation_seed_count(c.targets, known_scatter(last.sd, last.se),
+                                        c.budget.validation_min, c.budget.validation_max);
+    v.seeds = fresh_seeds(c.budget.validation_first, n, ev.seeds());
+    if (talk)
+      std::fprintf(stderr, "[rocklab calibrate] validation: the fitted card on %d fresh seeds\n",
+                   n);
+    const auto t = std::chrono::steady_clock::now();
+    const Evaluation e = ev.run_on(values, Stage::Final, v.seeds);
+    if (talk)
+      print_progress("validation", c, e, std::chrono::steady_clock::now() - t);
+    v.mean = e.mean, v.sd = e.sd, v.se = e.se, v.rejected = e.rejected_disks;
+    return v;
+  };
+  const Adopt adopt = [&](const std::vector<std::uint64_t>& s) { ev.adopt_seeds(s); };
   // Where a steered target's miss is within its noise, a seed more (up to the budget's).
   const AddSeed add_seed = [&] {
     const bool added = ev.add_seed(c.budget.max_seeds);
@@ -134,7 +136,9 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
     return added;
   };
   CampaignSummary cs;
-  cs.outcome = calibrate(params, c.targets, evaluate, c.budget, add_seed);
+  const Validated val =
+      calibrate_and_validate(params, c.targets, evaluate, c.budget, add_seed, validate, adopt);
+  cs.outcome = val.outcome;
   if (talk)
     for (const std::string& n : cs.outcome.notes)
       std::fprintf(stderr, "[rocklab calibrate] note: %s\n", n.c_str());
@@ -149,10 +153,15 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   std::vector<double> values;
   for (const Param& p : cs.outcome.params)
     values.push_back(p.value);
-  if (c.budget.validation_max > 0) {
-    validate(ev, c, values, r, talk);
+  if (val.rounds > 0) {
+    r.validation_seeds = val.validation.seeds;
+    r.validation_rejected = val.validation.rejected;
+    r.validation_mean = val.validation.mean;
+    r.validation_sd = val.validation.sd;
+    r.validation_se = val.validation.se;
+    r.validation_rounds = val.rounds;
     cs.validation_seeds = static_cast<int>(r.validation_seeds.size());
-    cs.validation_met = every_target_met(c.targets, r.validation_mean);
+    cs.validation_met = val.met;
   }
   if (c.budget.sensitivity) {
     if (talk)

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 
@@ -30,6 +31,11 @@ double children_cpu_seconds() {
          1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
+Evaluator::Evaluator(const CalibrationFile& c, EvaluatorOptions o) : c_(c), o_(std::move(o)) {
+  rows_ = SeedRows(!c_.seeds_file.empty() ? c_.seeds_file
+                                          : (fs::path(o_.out_dir) / "seeds.csv").string());
+}
+
 nlohmann::json Evaluator::tests_of(Stage s) const {
   if (s == Stage::Ratios || s == Stage::Final)
     return c_.tests;
@@ -40,6 +46,38 @@ nlohmann::json Evaluator::tests_of(Stage s) const {
   return out;
 }
 
+namespace {
+// A property measured on (or over) the Brazilian disk, other than its validity.
+bool reads_the_disk(const std::string& property) {
+  if (property == "brazilian_valid" || property == "brazilian_disks")
+    return false;
+  for (const TargetNeed& n : target_needs())
+    if (n.property == property &&
+        (std::string(n.test) == "brazilian" || (n.other && std::string(n.other) == "brazilian")))
+      return true;
+  return false;
+}
+
+// A finished replicate is reused unless one of its tests rejected its input (exit status 2). That
+// rejection stopped the campaign; once its cause is fixed (in the file, or in rocklab: a 3D packing
+// cache that could not be read back) a resumed campaign runs the replicate again instead of
+// stopping on the old verdict.
+bool reusable(const fs::path& suite_out) {
+  const fs::path f = suite_out / "summary.json";
+  if (!fs::exists(f))
+    return false;
+  try {
+    const nlohmann::json sm = read_json_file(f.string(), Nulls::Allow);
+    for (const auto& t : sm.value("tests", nlohmann::json::array()))
+      if (t.value("exit_status", 0) == 2)
+        return false;
+  } catch (const std::exception&) {
+    return false; // unreadable: run it again
+  }
+  return true;
+}
+} // namespace
+
 void Evaluator::run_suites(const nlohmann::json& card, const std::vector<const Replicate*>& todo) {
   if (todo.empty())
     return;
@@ -48,6 +86,7 @@ void Evaluator::run_suites(const nlohmann::json& card, const std::vector<const R
   // Several replicate suites at once, each with its share of the processes and of the cores.
   const int at_once = std::min(static_cast<int>(todo.size()), jobs);
   std::atomic<std::size_t> next{0};
+  std::mutex rows_mutex;
   std::vector<std::exception_ptr> errors(todo.size());
   auto worker = [&] {
     for (std::size_t i; (i = next.fetch_add(1)) < todo.size();) {
@@ -71,6 +110,13 @@ void Evaluator::run_suites(const nlohmann::json& card, const std::vector<const R
         so.threads = o_.ranks && o_.ranks->size() > 1 ? std::max(1, cores / jobs) : 0;
         so.interrupt = o_.interrupt;
         run_suite(load_suite((r.dir / "suite.json").string()), so);
+        // Its per-seed row at once: a run killed before the evaluation ends keeps it.
+        if ((!o_.ranks || o_.ranks->rank() == 0) && reusable(so.out_dir)) {
+          const nlohmann::json sm =
+              read_json_file((fs::path(so.out_dir) / "summary.json").string(), Nulls::Allow);
+          const std::lock_guard<std::mutex> lock(rows_mutex);
+          rows_.add(r.key, r.seed, sm["properties"]);
+        }
       } catch (...) {
         errors[i] = std::current_exception();
       }
@@ -109,43 +155,17 @@ void Evaluator::check_tests(const nlohmann::json& summary, const fs::path& suite
   }
 }
 
-namespace {
-// A property measured on (or over) the Brazilian disk, other than its validity.
-bool reads_the_disk(const std::string& property) {
-  if (property == "brazilian_valid" || property == "brazilian_disks")
-    return false;
-  for (const TargetNeed& n : target_needs())
-    if (n.property == property &&
-        (std::string(n.test) == "brazilian" || (n.other && std::string(n.other) == "brazilian")))
-      return true;
-  return false;
-}
-
-// A finished replicate is reused unless one of its tests rejected its input (exit status 2). That
-// rejection stopped the campaign; once its cause is fixed (in the file, or in rocklab: a 3D packing
-// cache that could not be read back) a resumed campaign runs the replicate again instead of
-// stopping on the old verdict.
-bool reusable(const fs::path& suite_out) {
-  const fs::path f = suite_out / "summary.json";
-  if (!fs::exists(f))
-    return false;
-  try {
-    const nlohmann::json sm = read_json_file(f.string(), Nulls::Allow);
-    for (const auto& t : sm.value("tests", nlohmann::json::array()))
-      if (t.value("exit_status", 0) == 2)
-        return false;
-  } catch (const std::exception&) {
-    return false; // unreadable: run it again
-  }
-  return true;
-}
-} // namespace
-
 bool Evaluator::add_seed(int max_seeds) {
   if (static_cast<int>(seeds_.size()) >= max_seeds)
     return false;
   seeds_.push_back(*std::max_element(seeds_.begin(), seeds_.end()) + 1);
   return true;
+}
+
+void Evaluator::adopt_seeds(const std::vector<std::uint64_t>& seeds) {
+  for (std::uint64_t s : seeds)
+    if (std::find(seeds_.begin(), seeds_.end(), s) == seeds_.end())
+      seeds_.push_back(s);
 }
 
 Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_t seeds) {
@@ -174,13 +194,13 @@ Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
       t["seed"] = seed;
     const std::string key =
         text_hash(card.dump() + "|" + ts.dump() + "|" + ROCKLAB_VERSION + revisions).substr(0, 16);
-    reps.push_back({fs::path(o_.out_dir) / "evaluations" / key, ts});
+    reps.push_back({fs::path(o_.out_dir) / "evaluations" / key, ts, key, seed});
   }
   // Which replicates are cached is decided once (rank 0) so that every rank shares out the same
   // list; this rank runs every size-th of the missing ones.
   std::string missing;
-  for (const Replicate& r : reps)
-    missing += reusable(r.dir / "suite") ? '0' : '1';
+  for (const Replicate& r : reps) // a folder, or a per-seed row (another run's), serves
+    missing += reusable(r.dir / "suite") || rows_.find(r.key) ? '0' : '1';
   const Ranks* ranks = o_.ranks;
   if (ranks)
     missing = ranks->broadcast(missing);
@@ -215,10 +235,18 @@ Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
   for (std::size_t i = 0; i < reps.size(); ++i) {
     (missing[i] == '1' ? run_ : ev.cached) += 1;
     const fs::path suite_out = reps[i].dir / "suite";
-    ev.folders.push_back(suite_out.string());
-    const nlohmann::json sm = read_json_file((suite_out / "summary.json").string(), Nulls::Allow);
-    check_tests(sm, suite_out, reps[i].tests);
-    const nlohmann::json& props = sm["properties"];
+    nlohmann::json props;
+    if (const nlohmann::json* row = rows_.find(reps[i].key); row && !reusable(suite_out)) {
+      ev.folders.push_back(rows_.path() + " (row " + reps[i].key + ")");
+      props = *row;
+    } else {
+      ev.folders.push_back(suite_out.string());
+      const nlohmann::json sm = read_json_file((suite_out / "summary.json").string(), Nulls::Allow);
+      check_tests(sm, suite_out, reps[i].tests);
+      props = sm["properties"];
+      if ((!ranks || ranks->rank() == 0) && !row)
+        rows_.add(reps[i].key, reps[i].seed, props); // a cached folder's row
+    }
     // The share of the seed's disks that were valid, and how many it had (lab/protocols/brazilian).
     const double valid = json_number(props, "brazilian_valid", 1.0);
     const bool rejected = valid == 0;

@@ -5,6 +5,7 @@
 
 #include "lab/calibration/calibration_file.hpp"
 #include "lab/calibration/ranks.hpp"
+#include "lab/calibration/seed_rows.hpp"
 
 #include <atomic>
 #include <cstdint>
@@ -49,7 +50,8 @@ std::vector<std::string> average_replicates(const std::map<std::string, std::vec
 
 class Evaluator {
 public:
-  Evaluator(const CalibrationFile& c, EvaluatorOptions o) : c_(c), o_(std::move(o)) {}
+  /// Per-seed rows come from and go to the file's seeds_file, else OUT_DIR/seeds.csv.
+  Evaluator(const CalibrationFile& c, EvaluatorOptions o);
   /// The tests of a stage: Elastic and Strength run the UCS tests only, Ratios and Final all.
   nlohmann::json tests_of(Stage s) const;
   /// Runs (or finds in the cache) the tests of stage `s` on the first `seeds` replicate seeds.
@@ -62,7 +64,11 @@ public:
   /// One more replicate seed (the next integer after the largest used), while fewer than
   /// `max_seeds`; false when there are that many already.
   bool add_seed(int max_seeds);
+  /// These seeds become replicate seeds too (a failed validation's: its results are evidence).
+  void adopt_seeds(const std::vector<std::uint64_t>& seeds);
   int suites_run() const { return run_; }
+  /// The per-seed results merged and written (its path for the report).
+  const SeedRows& seed_rows() const { return rows_; }
   int suites_cached() const { return cached_; }
 
 private:
@@ -70,6 +76,8 @@ private:
   struct Replicate {
     std::filesystem::path dir;
     nlohmann::json tests;
+    std::string key; ///< the cache key (the per-seed row's key)
+    std::uint64_t seed = 0;
   };
   /// Runs the suites of these replicates, up to `jobs` test processes at once in all.
   void run_suites(const nlohmann::json& card, const std::vector<const Replicate*>& todo);
@@ -79,6 +87,7 @@ private:
   const CalibrationFile& c_;
   EvaluatorOptions o_;
   std::vector<std::uint64_t> seeds_ = c_.seeds;
+  SeedRows rows_;
   int run_ = 0, cached_ = 0;
 };
 

@@ -28,6 +28,7 @@ struct ReportInput {
   int rejected = 0, validation_rejected = 0; ///< Brazilian disks not valid (ISRM), left out
   /// The fitted card on fresh seeds it was never tuned on (empty: no validation was run).
   std::vector<std::uint64_t> validation_seeds;
+  int validation_rounds = 0; ///< validations run (the last one's seeds and means are these)
   Measured validation_mean, validation_sd, validation_se;
   Sensitivity sensitivity;
   std::vector<std::string> final_folders; ///< the final evaluation's suites, one per seed

@@ -283,6 +283,11 @@ bool LoadingFrame::stop_rules() {
       finish(why);
     else if (loading > p_.max_steps)
       finish("stop.max_steps reached");
+  } else if (const std::string why = loading >= p_.min_steps && phase_ == kLoad
+                                         ? test_.stop_while_loading(*this)
+                                         : std::string();
+             !why.empty()) {
+    finish(why);
   } else if (p_.strain_limit > 0 && current_.axial_strain >= p_.strain_limit) {
     finish("stop.strain_limit reached");
   } else if (loading > p_.max_steps) {

@@ -100,7 +100,9 @@ public:
   // 6: strength before the loss of the diametral tension; 7: the fracture's origin (validity);
   // 8: a disk pressed travel_multiple times its peak's travel without a split ends; 9: a platen
   // start counts only beyond chance
-  int revision() const override { return 9; }
+  // 10: the strength corrected for the loaded arc; the test ends once the split disk lost its
+  // diametral tension
+  int revision() const override { return 10; }
   void read_options(JsonObject& loading, JsonObject& stop, const Protocol& p) override {
     if (loading.choice("jaws", {"flat", "curved"}, "flat") == "curved")
       jaw_ratio_ = loading.number("jaw_radius_ratio", Range::closed(1.1, 10), 1.5);
@@ -148,8 +150,23 @@ public:
     s.load = s.axial_stress;
   }
   void sampled(const LoadingFrame& f, const LabSample& s) override {
-    if (s.force > 0)
-      tension_.push_back({s.step, s.load, diametral_tension(f.model(), f.geometry()) / s.force});
+    if (!(s.force > 0))
+      return;
+    const LoadedArc arc = loaded_arc(f.model(), f.geometry());
+    TensionWatch& w = watch(f);
+    tension_.push_back({s.step, s.load, diametral_tension(f.model(), f.geometry()) / s.force,
+                        arc.half_angle, arc.contacts,
+                        static_cast<std::int64_t>(f.cracks().cracks().size()), s.axial_strain});
+    w.add(tension_.back());
+  }
+  // Once the disk has split and lost the tension across its loaded diameter, its strength is
+  // read (the largest load before the loss): the halves then carry the platens as columns, which
+  // says nothing more about the rock, so the test ends without waiting for the load to fall.
+  std::string stop_while_loading(LoadingFrame& f) override {
+    if (split_fraction_ <= 0 || f.reseating() || !watch_ || watch_->lost().step < 0 ||
+        !split_seen(f))
+      return "";
+    return "the disk split and lost the tension across its loaded diameter";
   }
   std::string stop_after_drop(LoadingFrame& f) override {
     // A disk can lose load locally (a grain crushed under a platen) and reload; only a split
@@ -206,8 +223,9 @@ public:
                                      {"radius_m", curved_jaw_radius(jaw_ratio_, f.geometry())}}
                     : nlohmann::json{{"shape", "flat"}};
     r["jaws"]["stiffness_ratio"] = cushion_;
+    r["diametral_readings"] = readings_json();
     if (split_fraction_ <= 0) { // the split check is off: the peak, as the user asked
-      r["tensile_strength_Pa"] = peak.load;
+      r["tensile_strength_Pa"] = arc_corrected(peak.step, peak.load, r);
       r["tensile_strength_method"] = "the peak of 2F/(pi D t) (stop.split_fraction 0)";
       r["peak_force_N"] = peak.force;
       r["peak_axial_strain"] = peak.strain;
@@ -246,7 +264,7 @@ public:
           " MPa, is not a tensile strength (crushing at the platens?); see crack_map.svg");
       return;
     }
-    r["tensile_strength_Pa"] = best.load;
+    r["tensile_strength_Pa"] = arc_corrected(best.step, best.load, r);
     r["tensile_strength_method"] =
         lost >= 0 ? "the largest 2F/(pi D t) before the tension carried across the loaded "
                     "diameter per unit load fell below " +
@@ -258,6 +276,34 @@ public:
     r["peak_axial_strain"] = best.axial_strain;
     r["split"]["stress_Pa"] = best.load;
   }
+  // The strength from the line-load 2F/(pi D t) `load` at `step`: times the factor of the loaded
+  // arc of the last reading up to that step (Hondros), recorded in r["loaded_arc"]. A disk with
+  // flats keeps its load (it already carries the flats' factor), and so does a step before any
+  // reading.
+  double arc_corrected(std::int64_t step, double load, nlohmann::json& r) const {
+    const TensionReading* at = nullptr;
+    for (const TensionReading& x : tension_)
+      if (x.step <= step)
+        at = &x;
+    if (!at)
+      return load;
+    const bool apply = flat_angle_ <= 0;
+    const double factor = apply ? flat_disk_factor(2 * at->arc) : 1.0;
+    r["loaded_arc"] = {
+        {"half_angle_deg", at->arc * 180 / std::numbers::pi},
+        {"platen_contacts", at->contacts},
+        {"step", at->step},
+        {"stress_factor", factor},
+        {"line_load_strength_Pa", load},
+        {"rule",
+         std::string("each platen's contacts weighted by their force along the loading axis: "
+                     "half-width a = sqrt(3) x their force-weighted standard deviation across "
+                     "it (a uniform load over [-a, a]), half-angle asin(a / R), the mean of the "
+                     "two platens; the strength is 2F/(pi D t) x (sin 2a - a) / a (Hondros 1959, "
+                     "the centre's tension under a load spread over two arcs 2a)") +
+             (apply ? "" : "; not applied: the flats' factor is")}};
+    return factor * load;
+  }
   PlotLabels plot_labels() const override {
     return {"platen displacement / D [%]", "2F / (pi D t) [MPa]", false, 2,
             "2F/(pi D t) vs platen displacement / D"};
@@ -268,6 +314,13 @@ public:
       std::printf("flats        loading angle %.4g deg: the load is 2F/(pi D t) x %.4g (Hondros)\n",
                   r["flats"]["loading_angle_deg"].get<double>(),
                   r["flats"]["stress_factor"].get<double>());
+    if (r.contains("loaded_arc") && r["loaded_arc"]["stress_factor"].get<double>() != 1)
+      std::printf("loaded arc   2a = %.3g deg over %d platen contacts at the strength: "
+                  "2F/(pi D t) %.4g MPa x %.4g (Hondros)\n",
+                  2 * r["loaded_arc"]["half_angle_deg"].get<double>(),
+                  r["loaded_arc"]["platen_contacts"].get<int>(),
+                  1e-6 * r["loaded_arc"]["line_load_strength_Pa"].get<double>(),
+                  r["loaded_arc"]["stress_factor"].get<double>());
     if (!r.contains("split")) { // the split check is off: the strength is the peak
       print_tensile_strength(r);
       return;
@@ -304,20 +357,27 @@ public:
     }
   }
   std::vector<SuiteProperty> suite_properties() const override {
-    return {{"bts_Pa"}, {"brazilian_valid"}, {"brazilian_disks"}};
+    return {{"bts_Pa"}, {"brazilian_valid"}, {"brazilian_disks"}, {"bts_not_valid_Pa"}};
   }
-  // The mean strength of the valid disks (ISRM); while none is valid, the first disk's, which
-  // brazilian_valid (the share of valid disks) 0 flags. brazilian_disks counts them all.
+  // The mean strength of the valid disks (ISRM); none while no disk is valid (a strength from a
+  // disk that failed at a platen is not the rock's): bts_not_valid_Pa, the mean of the disks that
+  // were not valid but gave a strength, says what they read. brazilian_disks counts them all,
+  // brazilian_valid is the valid share.
   void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override {
     const bool valid = r.contains("fracture_origin") && r["fracture_origin"].value("valid", false);
     const double x = json_number(r, "tensile_strength_Pa", std::nan(""));
     const double n = v.has("brazilian_disks") ? v.get("brazilian_disks") : 0;
     double k = n > 0 ? std::round(v.get("brazilian_valid") * n) : 0; // valid disks so far
+    auto mean_in = [&](const char* key, const char* count) {
+      const double c = v.has(count) ? v.get(count) : 0;
+      v.values[key] = c > 0 ? (v.get(key) * c + x) / (c + 1) : x;
+      v.values[count] = c + 1;
+    };
     if (valid && std::isfinite(x)) {
       v.values["bts_Pa"] = k > 0 ? (v.get("bts_Pa") * k + x) / (k + 1) : x;
       k += 1;
-    } else if (n == 0) {
-      v.values["bts_Pa"] = x;
+    } else if (std::isfinite(x)) {
+      mean_in("bts_not_valid_Pa", "brazilian_not_valid_strengths");
     }
     v.values["brazilian_disks"] = n + 1;
     v.values["brazilian_valid"] = k / (n + 1);
@@ -335,16 +395,22 @@ public:
   void save(nlohmann::json& state) const override {
     nlohmann::json t = nlohmann::json::array();
     for (const TensionReading& x : tension_)
-      t.push_back({x.step, x.load, x.ratio});
+      t.push_back({x.step, x.load, x.ratio, x.arc, x.contacts, x.cracks, x.strain});
     state["diametral_tension"] = std::move(t);
   }
   void load(const nlohmann::json& state, const std::string& file) override {
     tension_.clear();
     try {
       for (const auto& x : state.at("diametral_tension")) {
-        const TensionReading t{x.at(0).get<std::int64_t>(), x.at(1).get<double>(),
-                               x.at(2).get<double>()};
-        if (!std::isfinite(t.load) || !std::isfinite(t.ratio) || x.size() != 3)
+        TensionReading t{x.at(0).get<std::int64_t>(), x.at(1).get<double>(), x.at(2).get<double>()};
+        if (x.size() == 7) { // the loaded arc, cracks and travel (older checkpoints: none)
+          t.arc = x.at(3).get<double>();
+          t.contacts = x.at(4).get<int>();
+          t.cracks = x.at(5).get<std::int64_t>();
+          t.strain = x.at(6).get<double>();
+        }
+        if (!std::isfinite(t.load) || !std::isfinite(t.ratio) || !std::isfinite(t.arc) ||
+            !std::isfinite(t.strain) || (x.size() != 3 && x.size() != 7))
           throw std::domain_error("not finite");
         tension_.push_back(t);
       }
@@ -352,7 +418,8 @@ public:
       throw InputError(file + ": corrupt checkpoint (Brazilian 'diametral_tension' readings)");
     }
     bins_.reset();
-    scanned_ = 0; // rebinned from the restored cracks at the next check
+    watch_.reset(); // fed again from the restored readings at the next one
+    scanned_ = 0;   // rebinned from the restored cracks at the next check
     split_ = false;
   }
 
@@ -388,6 +455,32 @@ private:
       r["warnings"].push_back(std::string(b));
     }
   }
+  // The readings while loading, at most about 300 rows evenly spaced (and the last), for plots and
+  // for reading what the disk did between its first cracks and the end.
+  nlohmann::json readings_json() const {
+    nlohmann::json rows = nlohmann::json::array();
+    const std::size_t n = tension_.size(), every = std::max<std::size_t>(1, n / 300);
+    for (std::size_t i = 0; i < n; ++i)
+      if (i % every == 0 || i + 1 == n) {
+        const TensionReading& x = tension_[i];
+        rows.push_back({x.step, x.strain, x.load, x.ratio, x.arc * 180 / std::numbers::pi,
+                        x.contacts, x.cracks});
+      }
+    return {{"columns",
+             {"step", "platen_travel_over_D", "load_Pa", "tension_per_force",
+              "loaded_half_angle_deg", "platen_contacts", "cracks"}},
+            {"rows", std::move(rows)}};
+  }
+  // The loss of the diametral tension, watched reading by reading (from the readings so far when
+  // it starts, e.g. after a checkpoint's restoration).
+  TensionWatch& watch(const LoadingFrame& f) {
+    if (!watch_) {
+      watch_.emplace(kTensionKept, failed_fraction_, kTensionFloor * f.load_ref(), kTensionPersist);
+      for (const TensionReading& x : tension_)
+        watch_->add(x);
+    }
+    return *watch_;
+  }
   // Bins the cracks formed since the last check (results() finds the split's crack itself).
   bool split_seen(const LoadingFrame& f) {
     if (!bins_)
@@ -402,6 +495,7 @@ private:
   std::size_t scanned_ = 0;             ///< cracks already binned
   bool split_ = false;                  ///< the binned cracks make a split
   std::vector<TensionReading> tension_; ///< the diametral tension per unit force while loading
+  std::optional<TensionWatch> watch_;   ///< its loss, watched while loading
   // options
   double jaw_ratio_ = 0;         ///< curved jaws of this times the disk's radius; 0: flat platens
   double cushion_ = 1;           ///< platen contact stiffness over the specimen's wall contact
@@ -425,54 +519,6 @@ std::int64_t split_crack_step(const std::vector<Crack>& cracks, const SpecimenGe
     if (bins.add(c))
       return c.step;
   return -1;
-}
-
-double diametral_tension(const Model& m, const SpecimenGeometry& g) {
-  std::array<double, 5> planes{};
-  for (std::size_t k = 0; k < planes.size(); ++k)
-    planes[k] = g.center.x() + (static_cast<double>(k) - 2.0) * 0.05 * g.width0.x();
-  const std::vector<Contact>& cs = m.contacts();
-  const std::vector<ContactOutput>& out = m.contact_outputs();
-  double t = 0;
-  for (std::size_t i = 0; i < cs.size(); ++i) {
-    const Contact& c = cs[i];
-    if (c.kind != ContactKind::BallBall)
-      continue;
-    const double x1 = m.balls.pos[static_cast<std::size_t>(c.end1)].x();
-    const double x2 = m.balls.pos[static_cast<std::size_t>(c.end2)].x();
-    for (double x : planes) {
-      if ((x1 - x) * (x2 - x) >= 0)
-        continue; // does not cross this plane
-      // The force on grain 2 pulls it back across the plane: tension.
-      const double pull = x2 > x ? -out[i].force.x() : out[i].force.x();
-      t += std::max(pull, 0.0);
-    }
-  }
-  return t / static_cast<double>(planes.size());
-}
-
-TensionLoss tension_loss(const std::vector<TensionReading>& r, double kept, double failed,
-                         double floor, std::int64_t persist) {
-  double peak = 0, ref = 0;
-  TensionLoss low; // the first reading of the current run below kept * ref (step -1: none)
-  for (const TensionReading& x : r) {
-    peak = std::max(peak, x.load);
-    if (x.load < floor || x.load < failed * peak)
-      continue; // the seating load, or a collapse: neither confirms nor ends a run
-    if (ref > 0 && x.ratio < kept * ref) {
-      if (low.step < 0)
-        low = {x.step, ref, x.ratio};
-      if (x.step - low.step >= persist)
-        return low;
-      continue;
-    }
-    low.step = -1;
-    if (x.load >= 0.9 * peak)
-      ref = std::max(ref, x.ratio);
-  }
-  if (low.step >= 0)
-    return low; // still below when the test ended
-  return {-1, ref, 0};
 }
 
 LabSample strongest_before(const std::vector<LabSample>& samples, const PeakRecord& peak,

@@ -29,11 +29,37 @@ std::int64_t split_crack_step(const std::vector<Crack>& cracks, const SpecimenGe
 /// An elastic disk under line loads carries 2F/pi across its diameter (Hondros; Jaeger & Cook).
 double diametral_tension(const Model& m, const SpecimenGeometry& g);
 
+/// How the platens spread their load over the disk's rim (lab/protocols/brazilian_arc.cpp). Each
+/// platen's contacts are weighted by their force along the loading axis; the arc is that of a
+/// uniform load with the same force-weighted spread across the loading axis: half-width a =
+/// sqrt(3) x the force-weighted standard deviation of the contacts' offsets from their centroid
+/// (exact for a uniform pressure over [-a, a], 0 for one contact), half-angle asin(a / R).
+struct LoadedArc {
+  double half_angle = 0; ///< the mean of the two platens' half-angles [rad]
+  int contacts = 0;      ///< platen contacts carrying load (both platens)
+};
+LoadedArc loaded_arc(const Model& m, const SpecimenGeometry& g);
+/// One platen's contacts as loaded_arc sums them: offsets x across the loading axis [m] weighted
+/// by their force f [N].
+struct ArcSums {
+  double w = 0, x = 0, xx = 0;
+  int n = 0;
+  void add(double offset, double force) {
+    w += force, x += force * offset, xx += force * offset * offset, n += 1;
+  }
+  /// The half-width of the uniform load with the same force-weighted spread [m] (0: none).
+  double half_width() const;
+};
+
 /// One reading of the tension across the diameter per unit platen force [-] (elastic disk under
-/// line loads: 2/pi on one plane) with the load [Pa] at the same step.
+/// line loads: 2/pi on one plane) with the load [Pa] and the loaded arc at the same step.
 struct TensionReading {
   std::int64_t step = 0;
   double load = 0, ratio = 0;
+  double arc = 0;          ///< LoadedArc::half_angle [rad]
+  int contacts = 0;        ///< LoadedArc::contacts
+  std::int64_t cracks = 0; ///< cracks so far
+  double strain = 0;       ///< platen travel / D [-]
 };
 
 /// When the disk lost its diametral tension: the first reading of a run of readings whose ratio
@@ -48,6 +74,24 @@ struct TensionLoss {
 };
 TensionLoss tension_loss(const std::vector<TensionReading>& r, double kept, double failed,
                          double floor, std::int64_t persist);
+
+/// tension_loss one reading at a time (the test's stop rule reads it while loading).
+class TensionWatch {
+public:
+  TensionWatch(double kept, double failed, double floor, std::int64_t persist)
+      : kept_(kept), failed_(failed), floor_(floor), persist_(persist) {}
+  void add(const TensionReading& x);
+  /// A loss that lasted `persist` steps (step -1: none yet).
+  const TensionLoss& lost() const { return lost_; }
+  /// As tension_loss: a lasting loss, else one still running, else the reference alone.
+  TensionLoss result() const;
+
+private:
+  double kept_, failed_, floor_;
+  std::int64_t persist_;
+  double peak_ = 0, ref_ = 0;
+  TensionLoss low_, lost_;
+};
 
 /// The reading with the largest load up to step `split` (the peak itself when it came first);
 /// load -1 when no reading precedes the split.

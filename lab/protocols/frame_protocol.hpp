@@ -74,6 +74,9 @@ public:
   /// Called at stop checks once the load fell below stop.post_peak_fraction of its peak: the stop
   /// reason, or "" to go on (default: stop).
   virtual std::string stop_after_drop(LoadingFrame& f);
+  /// Called at stop checks while loading, past stop.min_steps, before any drop: a stop reason, or
+  /// "" to go on (default: go on).
+  virtual std::string stop_while_loading(LoadingFrame& /*f*/) { return ""; }
   /// The test's own results (the frame writes the common ones).
   virtual void results(const LoadingFrame& f, nlohmann::json& r) const = 0;
   virtual PlotLabels plot_labels() const = 0;
