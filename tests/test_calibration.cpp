@@ -501,6 +501,8 @@ nlohmann::json tiny_calibration(const std::string& name, const std::vector<int>&
             {"strength", strength},
             {"ratios", 0},
             {"polish", polish},
+            {"max_seeds", static_cast<int>(seeds.size())}, // no seeds added: a quick campaign
+            {"validation_rounds", 1},
             {"validation_max", 6}}}};
 }
 

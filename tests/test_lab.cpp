@@ -617,6 +617,34 @@ TEST(Lab, ACushionedPlatenTravelsFurtherAndMeasuresTheSameDisk) {
   }
 }
 
+// The disk's stop rule on a disk that splits: with the post-peak rule set low, the test ends once
+// the split disk has lost the tension across its loaded diameter for 1,000 steps, with the same
+// strength as the run that waited for the load to fall, and the loaded arc is recorded.
+TEST(Lab, ASplitDiskThatLostItsDiametralTensionEndsThere) {
+  const LabSummary& flat = flat_disk_run();
+  const std::string spec = (test::scratch_root() / "bz_flat" / "specimen.rlspec").string();
+  const LabSummary low = run("bz_tension_stop",
+                             {{"test", "brazilian"},
+                              {"specimen", {{"file", spec}}},
+                              {"stop", {{"post_peak_fraction", 0.2}, {"failed_fraction", 0.1}}},
+                              {"output", {{"vtk", false}, {"plots", false}}}},
+                             scratch("bz_tension_stop"));
+  const nlohmann::json& r = low.results;
+  EXPECT_EQ(r["stop_reason"], "the disk split and lost the tension across its loaded diameter");
+  const std::int64_t lost = r["split"]["tension_lost_step"].get<std::int64_t>();
+  ASSERT_GT(lost, 0) << r["split"].dump();
+  EXPECT_EQ(r["provenance"]["steps"].get<std::int64_t>(), lost + 1000);
+  EXPECT_EQ(r["tensile_strength_Pa"], flat.results["tensile_strength_Pa"]);
+  // The loaded arc at the strength: one grain under each platen of this coarse 2D disk.
+  EXPECT_EQ(r["loaded_arc"]["platen_contacts"].get<int>(), 2);
+  EXPECT_DOUBLE_EQ(r["loaded_arc"]["stress_factor"].get<double>(), 1.0);
+  EXPECT_EQ(r["loaded_arc"]["line_load_strength_Pa"], r["tensile_strength_Pa"]);
+  const nlohmann::json& rows = r["diametral_readings"]["rows"];
+  ASSERT_GT(rows.size(), 10u);
+  EXPECT_LE(rows.size(), 302u);
+  EXPECT_EQ(r["diametral_readings"]["columns"][3], "tension_per_force");
+}
+
 // stop.split_fraction 0 turns the split check off: the strength is the peak, and results.json
 // says so (a rename once mangled this text into "stosplit_fraction_ 0").
 TEST(Lab, ABrazilianTestWithoutTheSplitCheckReportsThePeak) {

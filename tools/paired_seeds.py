@@ -28,8 +28,13 @@ HALF_TOLERANCE = {"ucs": 0.025, "brazilian": 0.04, "direct_tension": 0.04}
 
 
 def suite_tests(preset):
-    suite = json.load(open(os.path.join(ROOT, "lab", "suites", preset + ".json")))
+    """SUITE (lab/suites/SUITE.json) or SUITE:CARD (that suite's tests on materials/CARD.json, for
+    a preset without a suite of its own, e.g. granite_2d:berea_fj_2d)."""
+    name, _, card = preset.partition(":")
+    suite = json.load(open(os.path.join(ROOT, "lab", "suites", name + ".json")))
     material = os.path.normpath(os.path.join(ROOT, "lab", "suites", suite["material"]))
+    if card:
+        material = os.path.join(ROOT, "materials", card + ".json")
     return material, [t for t in suite["tests"] if t["test"] in ("ucs", "brazilian")]
 
 
@@ -74,7 +79,7 @@ def one_row(args, preset, test, seed, setting, spec):
     proto.update({"units": "SI", "specimen": {"file": spec}, "output": {"vtk": False,
                                                                          "plots": False}})
     proto.setdefault("loading", {})[args.key] = float(setting)
-    tag = "%s_%s_%d_%s" % (preset, test["name"], seed, setting)
+    tag = "%s_%s_%d_%s" % (preset.replace(":", "-"), test["name"], seed, setting)
     work = os.path.join(args.out, "runs", tag)
     os.makedirs(os.path.dirname(work), exist_ok=True)
     pfile = work + ".json"
@@ -84,6 +89,8 @@ def one_row(args, preset, test, seed, setting, spec):
                  work + ".log")
     row = {"preset": preset, "test": test["name"], "seed": seed, "setting": setting,
            "wall_s": "%.0f" % (time.time() - t0)}
+    if status < 0:  # killed (the session ended): no row, so that a later run repeats it
+        sys.exit("rocklab was killed by signal %d: stopped without a row" % -status)
     if status != 0:
         row["stop_reason"] = "exit %d" % status
         return row
@@ -143,13 +150,40 @@ def num(x):
         return float("nan")
 
 
+def window_fit(run_dir, window):
+    """E and nu by least squares over the loading branch between two deviator levels [Pa] (the
+    base run's elastic window), from history.csv: the same stresses in both runs of a pair, so a
+    crack onset that comes a little earlier or later (chaotic) does not move the window."""
+    path = os.path.join(run_dir, "history.csv")
+    if not os.path.exists(path) or not window:
+        return float("nan"), float("nan")
+    xs, ys, ls = [], [], []
+    with open(path) as f:
+        for r in csv.DictReader(f):
+            if r["phase"] != "2":
+                continue
+            q = float(r["deviator_Pa"])
+            if q > window[1]:
+                break
+            if q >= window[0]:
+                xs.append(float(r["axial_strain"]))
+                ys.append(q)
+                ls.append(float(r["lateral_strain"]))
+    if len(xs) < 3:
+        return float("nan"), float("nan")
+    def slope(a, b):
+        ma, mb = sum(a) / len(a), sum(b) / len(b)
+        return sum((x - ma) * (y - mb) for x, y in zip(a, b)) / sum((x - ma) ** 2 for x in a)
+    return slope(xs, ys), -slope(xs, ls)
+
+
 def cmd_report(args):
     rows = list(done_rows(os.path.join(args.out, "rows.csv")).values())
     base = args.base
     groups = {}
     for r in rows:
         groups.setdefault((r["preset"], r["test"]), {}).setdefault(r["seed"], {})[r["setting"]] = r
-    print("| preset | test | setting | seeds | E shift | nu shift | strength shift, mean "
+    print("| preset | test | setting | seeds | E shift (same window) | nu shift | strength shift, mean "
           "[95 % interval] | within +-half tolerance | largest ledger error | loading steps |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for (preset, test), by_seed in sorted(groups.items()):
@@ -164,8 +198,23 @@ def cmd_report(args):
                 if num(a["loading_steps"]) > 0:
                     steps.append(num(b["loading_steps"]) / num(a["loading_steps"]) - 1)
                 if num(a["youngs_modulus_Pa"]) > 0:
-                    de.append(num(b["youngs_modulus_Pa"]) / num(a["youngs_modulus_Pa"]) - 1)
-                    dn.append(num(b["poisson_ratio"]) - num(a["poisson_ratio"]))
+                    # over the base run's window in both (history.csv), where the runs are kept
+                    runs = os.path.join(args.out, "runs")
+                    tag = lambda r: "%s_%s_%s_%s" % (preset.replace(":", "-"), test, r["seed"],
+                                                     r["setting"])
+                    try:
+                        w = json.load(open(os.path.join(runs, tag(a), "results.json")))[
+                            "elastic_fit"]["window_Pa"]
+                    except (OSError, KeyError, ValueError):
+                        w = None
+                    ea, na = window_fit(os.path.join(runs, tag(a)), w)
+                    eb, nb = window_fit(os.path.join(runs, tag(b)), w)
+                    if math.isfinite(ea) and math.isfinite(eb):
+                        de.append(eb / ea - 1)
+                        dn.append(nb - na)
+                    else:
+                        de.append(num(b["youngs_modulus_Pa"]) / num(a["youngs_modulus_Pa"]) - 1)
+                        dn.append(num(b["poisson_ratio"]) - num(a["poisson_ratio"]))
                 if num(a["strength_Pa"]) > 0 and num(b["strength_Pa"]) > 0:
                     ds.append(num(b["strength_Pa"]) / num(a["strength_Pa"]) - 1)
             n = len(ds)

@@ -199,8 +199,12 @@ Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
   // Which replicates are cached is decided once (rank 0) so that every rank shares out the same
   // list; this rank runs every size-th of the missing ones.
   std::string missing;
-  for (const Replicate& r : reps) // a folder, or a per-seed row (another run's), serves
-    missing += reusable(r.dir / "suite") || rows_.find(r.key) ? '0' : '1';
+  // A finished folder serves, or else a per-seed row (another run's); a folder whose test rejected
+  // its input is run again whatever a row says (the row is older than that verdict).
+  for (const Replicate& r : reps) {
+    const bool folder = fs::exists(r.dir / "suite" / "summary.json");
+    missing += reusable(r.dir / "suite") || (!folder && rows_.find(r.key)) ? '0' : '1';
+  }
   const Ranks* ranks = o_.ranks;
   if (ranks)
     missing = ranks->broadcast(missing);

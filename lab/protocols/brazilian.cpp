@@ -459,7 +459,7 @@ private:
   // for reading what the disk did between its first cracks and the end.
   nlohmann::json readings_json() const {
     nlohmann::json rows = nlohmann::json::array();
-    const std::size_t n = tension_.size(), every = std::max<std::size_t>(1, n / 300);
+    const std::size_t n = tension_.size(), every = std::max<std::size_t>(1, (n + 299) / 300);
     for (std::size_t i = 0; i < n; ++i)
       if (i % every == 0 || i + 1 == n) {
         const TensionReading& x = tension_[i];

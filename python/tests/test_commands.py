@@ -55,8 +55,8 @@ def test_calibrate_writes_its_card_and_report(tmp_path):
            "tests": [{"name": "ucs", "test": "ucs", "stop": {"strain_limit": 0.003},
                       "output": {"vtk": False, "plots": False}}],
            "seeds": [1],
-           "budget": {"elastic": 2, "strength": 0, "ratios": 0, "polish": 0,
-                      "validation_min": 2, "validation_max": 2}}
+           "budget": {"elastic": 2, "strength": 0, "ratios": 0, "polish": 0, "max_seeds": 1,
+                      "validation_min": 2, "validation_max": 2, "validation_rounds": 1}}
     r = rocklab.calibrate(cal, tmp_path / "cal", jobs=2)
     assert r.card["flatjoint"]["fj_emod"] > 0
     assert "youngs_modulus_Pa" in r.report or "Young" in r.report
