@@ -77,6 +77,45 @@ void print_progress(const std::string& what, const CalibrationFile& c, const Eva
                std::chrono::duration<double>(took).count(), cpu);
 }
 
+// The fitted card on fresh seeds it was never tuned on (nor an earlier validation used): as many
+// as make each target's standard error half its tolerance (from the last evaluation's scatter),
+// within the budget's bounds.
+ValidationRun validation(Evaluator& ev, const CalibrationFile& c, const std::vector<double>& values,
+                         const Evaluation& last, bool talk) {
+  ValidationRun v;
+  const int n = validation_seed_count(c.targets, known_scatter(last.sd, last.se),
+                                      c.budget.validation_min, c.budget.validation_max);
+  v.seeds = fresh_seeds(c.budget.validation_first, n, ev.seeds());
+  if (talk)
+    std::fprintf(stderr, "[rocklab calibrate] validation: the fitted card on %d fresh seeds\n", n);
+  const auto t = std::chrono::steady_clock::now();
+  const Evaluation e = ev.run_on(values, Stage::Final, v.seeds);
+  if (talk)
+    print_progress("validation", c, e, std::chrono::steady_clock::now() - t);
+  v.mean = e.mean, v.sd = e.sd, v.se = e.se, v.rejected = e.rejected_disks;
+  return v;
+}
+
+// The fitted card (its source says the verdict), convergence.csv/.svg and report.md.
+void write_outputs(const std::string& file, const CalibrationFile& c, const CampaignSummary& cs,
+                   const ReportInput& r, const std::vector<double>& values,
+                   const std::string& out_dir) {
+  nlohmann::json card = apply_params(c.material, c.params, values);
+  std::string verdict = cs.outcome.met ? "every target met" : "not every target met";
+  if (cs.validation_seeds > 0)
+    verdict += std::string(cs.validation_met ? ", and" : ", not every one") + " on " +
+               std::to_string(cs.validation_seeds) + " fresh validation seeds";
+  card["source"] = "Calibrated by rocklab calibrate " + fs::path(file).filename().string() +
+                   " from " + fs::path(c.material_file).filename().string() + " (" + verdict +
+                   "; see report.md).";
+  const fs::path out(out_dir);
+  write_text_file(out / "card.json", card.dump(2) + "\n");
+  write_text_file(out / "convergence.csv", convergence_csv(c, cs.outcome));
+  write_svg_and_png(out / "convergence.svg",
+                    convergence_svg(c, cs.outcome, &r.validation_mean, r.validation_seeds.size()));
+  write_text_file(out / "report.md", report_md(r));
+}
+
 } // namespace
 
 CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o) {
@@ -108,23 +147,8 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
     m[kSeedCount] = static_cast<double>(last.folders.size());
     return m;
   };
-  // The fitted card on fresh seeds it was never tuned on (nor an earlier validation used): as
-  // many as make each target's standard error half its tolerance (from the last evaluation's
-  // scatter), within the budget's bounds.
   const Validate validate = [&](const std::vector<double>& values) {
-    ValidationRun v;
-    const int n = validation_seed_count(c.targets, known_scatter(last.sd, last.se),
-                                        c.budget.validation_min, c.budget.validation_max);
-    v.seeds = fresh_seeds(c.budget.validation_first, n, ev.seeds());
-    if (talk)
-      std::fprintf(stderr, "[rocklab calibrate] validation: the fitted card on %d fresh seeds\n",
-                   n);
-    const auto t = std::chrono::steady_clock::now();
-    const Evaluation e = ev.run_on(values, Stage::Final, v.seeds);
-    if (talk)
-      print_progress("validation", c, e, std::chrono::steady_clock::now() - t);
-    v.mean = e.mean, v.sd = e.sd, v.se = e.se, v.rejected = e.rejected_disks;
-    return v;
+    return validation(ev, c, values, last, talk);
   };
   const Adopt adopt = [&](const std::vector<std::uint64_t>& s) { ev.adopt_seeds(s); };
   // Where a steered target's miss is within its noise, a seed more (up to the budget's).
@@ -180,20 +204,7 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
     r.cpu_seconds = o.ranks->sum(r.cpu_seconds);
   if (o.ranks && !o.ranks->root())
     return cs; // rank 0 writes the outputs
-  nlohmann::json card = apply_params(c.material, c.params, values);
-  std::string verdict = cs.outcome.met ? "every target met" : "not every target met";
-  if (cs.validation_seeds > 0)
-    verdict += std::string(cs.validation_met ? ", and" : ", not every one") + " on " +
-               std::to_string(cs.validation_seeds) + " fresh validation seeds";
-  card["source"] = "Calibrated by rocklab calibrate " + fs::path(file).filename().string() +
-                   " from " + fs::path(c.material_file).filename().string() + " (" + verdict +
-                   "; see report.md).";
-  const fs::path out(o.out_dir);
-  write_text_file(out / "card.json", card.dump(2) + "\n");
-  write_text_file(out / "convergence.csv", convergence_csv(c, cs.outcome));
-  write_svg_and_png(out / "convergence.svg",
-                    convergence_svg(c, cs.outcome, &r.validation_mean, r.validation_seeds.size()));
-  write_text_file(out / "report.md", report_md(r));
+  write_outputs(file, c, cs, r, values, o.out_dir);
   return cs;
 }
 

@@ -29,56 +29,6 @@ namespace rocklab {
 
 namespace {
 
-// Cracks within 0.2 D of the loaded diameter (the y axis through the centre), binned by their
-// position along it: the split is complete once one run of cracked tenths spans `need` of the ten
-// bins. A run may bridge one single empty tenth: a fracture through a contact that had no bond to
-// break (slit or unbonded) leaves no crack record there (a 2D disk whose load collapsed to 0.3 of
-// its peak along a diametral fracture had cracks in every tenth but one). Only one: scattered
-// cracks in every other tenth are diffuse damage, not a split (bridging them all declared one at
-// 7 MPa in a disk that failed at 27). Crushing under both platens covers the two ends of the
-// diameter, not the middle, and does not join up.
-class SplitBins {
-public:
-  SplitBins(const SpecimenGeometry& g, double fraction)
-      : d_(g.width0.y()), centre_(g.center),
-        need_(static_cast<int>(std::ceil(fraction * 10.0 - 1e-9))) {}
-  /// Bins one crack; true once the run is long enough.
-  bool add(const Crack& c) {
-    const Vec3 rel = c.position - centre_;
-    if (std::abs(rel.x()) <= 0.2 * d_) {
-      const double t = (rel.y() + 0.5 * d_) / d_;
-      bins_[static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor(t * 10.0)), 0, 9))] =
-          true;
-    }
-    int longest = 0;
-    auto cracked = [&](int i) { return i < 10 && bins_[static_cast<std::size_t>(i)]; };
-    for (int a = 0; a < 10; ++a) { // the run from each cracked tenth, with at most one bridge
-      if (!cracked(a))
-        continue;
-      int b = a;
-      bool bridged = false;
-      for (;;) {
-        if (cracked(b + 1)) {
-          b += 1;
-        } else if (!bridged && cracked(b + 2)) {
-          b += 2;
-          bridged = true;
-        } else {
-          break;
-        }
-      }
-      longest = std::max(longest, b - a + 1);
-    }
-    return longest >= need_;
-  }
-
-private:
-  double d_;
-  Vec3 centre_;
-  int need_;
-  std::array<bool, 10> bins_{};
-};
-
 constexpr int kMaxReseats = 3; ///< platen re-seatings after a collapse without a split
 /// The split released the diametral tension once it fell below this fraction of its value per
 /// unit force (measured on 2D disks whose halves then loaded as columns: 0.4-0.55 of it remained
@@ -506,37 +456,6 @@ private:
 };
 
 } // namespace
-
-double flat_disk_factor(double loading_angle) {
-  const double a = 0.5 * loading_angle;
-  return a > 0 ? (std::sin(2 * a) - a) / a : 1.0;
-}
-
-std::int64_t split_crack_step(const std::vector<Crack>& cracks, const SpecimenGeometry& g,
-                              double fraction) {
-  SplitBins bins(g, fraction);
-  for (const Crack& c : cracks)
-    if (bins.add(c))
-      return c.step;
-  return -1;
-}
-
-LabSample strongest_before(const std::vector<LabSample>& samples, const PeakRecord& peak,
-                           std::int64_t split) {
-  LabSample best;
-  best.load = -1;
-  if (split < 0)
-    return best;
-  if (peak.step >= 0 && peak.step <= split) {
-    best.step = peak.step, best.time = peak.time, best.axial_strain = peak.strain;
-    best.axial_stress = peak.stress, best.load = peak.load, best.force = peak.force;
-    return best;
-  }
-  for (const LabSample& s : samples)
-    if (s.step <= split && s.load > best.load)
-      best = s;
-  return best;
-}
 
 std::unique_ptr<LabProtocol> make_brazilian_test() {
   return std::make_unique<BrazilianTest>();

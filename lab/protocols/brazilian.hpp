@@ -5,6 +5,7 @@
 #include "lab/crack_monitor.hpp"
 #include "lab/frame/loading_frame.hpp"
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -16,6 +17,26 @@ namespace rocklab {
 /// that subtend `loading_angle` = 2a at the centre: (sin 2a - a) / a (Hondros 1959; 1 for a line
 /// load, 0.960 at 2a = 20 deg, 0.910 at 30 deg); a flattened disk's flats load it so.
 double flat_disk_factor(double loading_angle);
+
+/// Cracks within 0.2 D of the loaded diameter (the y axis through the centre), binned by their
+/// position along it in ten tenths: the split is complete once one run of cracked tenths spans
+/// `fraction` of them, bridging at most one single empty tenth (a fracture through a contact with
+/// no bond to break, slit or unbonded, leaves no crack record there; scattered cracks in every
+/// other tenth are diffuse damage, not a split: bridging them all declared one at 7 MPa in a 2D
+/// disk that failed at 27). Crushing under both platens covers the two ends of the diameter, not
+/// the middle, and does not join up.
+class SplitBins {
+public:
+  SplitBins(const SpecimenGeometry& g, double fraction);
+  /// Bins one crack; true once the run is long enough.
+  bool add(const Crack& c);
+
+private:
+  double d_;
+  Vec3 centre_;
+  int need_;
+  std::array<bool, 10> bins_{};
+};
 
 /// The step of the crack that completed the diametral split (cracks within 0.2 D of the loaded
 /// diameter spanning `fraction` of its ten bins in one run that bridges at most one empty bin),

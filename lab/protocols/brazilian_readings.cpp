@@ -1,9 +1,9 @@
-// The Brazilian test's readings while loading (lab/protocols/brazilian.hpp): the tension the disk
-// carries across its loaded diameter, when it lost it, and the arc over which the platens load the
-// disk. A flat platen on a round disk touches one or two rim grains; a cushion, a sunk platen or
-// flats spread the load over more of the rim, and the centre's tension under a load spread
-// uniformly over two arcs 2a is 2F/(pi D t) x (sin 2a - a) / a (Hondros 1959), below the line-load
-// value. Units SI.
+// The Brazilian test's readings while loading (lab/protocols/brazilian.hpp): the split's crack run,
+// the tension the disk carries across its loaded diameter, when it lost it, the strongest reading
+// before that, and the arc over which the platens load the disk. A flat platen on a round disk
+// touches one or two rim grains; a cushion, a sunk platen or flats spread the load over more of the
+// rim, and the centre's tension under a load spread uniformly over two arcs 2a is 2F/(pi D t) x
+// (sin 2a - a) / a (Hondros 1959), below the line-load value. Units SI.
 #include "lab/protocols/brazilian.hpp"
 
 #include <algorithm>
@@ -107,6 +107,70 @@ TensionLoss tension_loss(const std::vector<TensionReading>& r, double kept, doub
       break;
   }
   return w.result();
+}
+
+SplitBins::SplitBins(const SpecimenGeometry& g, double fraction)
+    : d_(g.width0.y()), centre_(g.center),
+      need_(static_cast<int>(std::ceil(fraction * 10.0 - 1e-9))) {}
+
+bool SplitBins::add(const Crack& c) {
+  const Vec3 rel = c.position - centre_;
+  if (std::abs(rel.x()) <= 0.2 * d_) {
+    const double t = (rel.y() + 0.5 * d_) / d_;
+    bins_[static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor(t * 10.0)), 0, 9))] =
+        true;
+  }
+  int longest = 0;
+  auto cracked = [&](int i) { return i < 10 && bins_[static_cast<std::size_t>(i)]; };
+  for (int a = 0; a < 10; ++a) { // the run from each cracked tenth, with at most one bridge
+    if (!cracked(a))
+      continue;
+    int b = a;
+    bool bridged = false;
+    for (;;) {
+      if (cracked(b + 1)) {
+        b += 1;
+      } else if (!bridged && cracked(b + 2)) {
+        b += 2;
+        bridged = true;
+      } else {
+        break;
+      }
+    }
+    longest = std::max(longest, b - a + 1);
+  }
+  return longest >= need_;
+}
+
+double flat_disk_factor(double loading_angle) {
+  const double a = 0.5 * loading_angle;
+  return a > 0 ? (std::sin(2 * a) - a) / a : 1.0;
+}
+
+std::int64_t split_crack_step(const std::vector<Crack>& cracks, const SpecimenGeometry& g,
+                              double fraction) {
+  SplitBins bins(g, fraction);
+  for (const Crack& c : cracks)
+    if (bins.add(c))
+      return c.step;
+  return -1;
+}
+
+LabSample strongest_before(const std::vector<LabSample>& samples, const PeakRecord& peak,
+                           std::int64_t split) {
+  LabSample best;
+  best.load = -1;
+  if (split < 0)
+    return best;
+  if (peak.step >= 0 && peak.step <= split) {
+    best.step = peak.step, best.time = peak.time, best.axial_strain = peak.strain;
+    best.axial_stress = peak.stress, best.load = peak.load, best.force = peak.force;
+    return best;
+  }
+  for (const LabSample& s : samples)
+    if (s.step <= split && s.load > best.load)
+      best = s;
+  return best;
 }
 
 } // namespace rocklab
