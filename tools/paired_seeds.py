@@ -9,7 +9,8 @@ once, so a run longer than a session continues where it stopped (the rows are sm
   tools/paired_seeds.py report --out DIR [--rule]       (paired mean shifts, 95 % intervals)
 
 Each specimen is made once by `rocklab genesis` (DIR/specimens/) and both settings load it, so the
-pair differs only in the loading. Units SI throughout (Pa, -, s).
+pair differs only in the loading; with --card-key the setting is a card key instead and each
+setting has its own specimen of the same seed (a genesis rule). Units SI throughout (Pa, -, s).
 """
 import argparse
 import csv
@@ -58,6 +59,24 @@ def run(cmd, log):
         return subprocess.call(cmd, stdout=out, stderr=subprocess.STDOUT)
 
 
+def card_for(args, material, setting):
+    """With --card-key (a genesis setting, e.g. packing.equilibrium_ratio): a copy of the card
+    with that key set, so that each setting has its own specimen; else the card itself."""
+    if not args.card_key:
+        return material
+    card = json.load(open(material))
+    *path, last = args.card_key.split(".")
+    node = card
+    for k in path:
+        node = node.setdefault(k, {})
+    node[last] = float(setting)
+    out = os.path.join(args.out, "cards", "%s_%s.json" % (os.path.basename(material)[:-5],
+                                                           setting))
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    json.dump(card, open(out, "w"), indent=1)
+    return out
+
+
 def specimen(args, material, test, seed):
     name = "%s_%s_%d.rlspec" % (os.path.basename(material)[:-5], test["name"], seed)
     path = os.path.join(args.out, "specimens", name)
@@ -78,7 +97,8 @@ def one_row(args, preset, test, seed, setting, spec):
     proto = {k: v for k, v in test.items() if k not in ("name", "shape", "cut")}
     proto.update({"units": "SI", "specimen": {"file": spec}, "output": {"vtk": False,
                                                                          "plots": False}})
-    proto.setdefault("loading", {})[args.key] = float(setting)
+    if not args.card_key:
+        proto.setdefault("loading", {})[args.key] = float(setting)
     tag = "%s_%s_%d_%s" % (preset.replace(":", "-"), test["name"], seed, setting)
     work = os.path.join(args.out, "runs", tag)
     os.makedirs(os.path.dirname(work), exist_ok=True)
@@ -121,8 +141,8 @@ def cmd_run(args):
                         if (preset, test["name"], str(seed), s) not in done]
                 if not todo:
                     continue
-                spec = specimen(args, material, test, seed)
                 for setting in todo:
+                    spec = specimen(args, card_for(args, material, setting), test, seed)
                     row = one_row(args, preset, test, seed, setting, spec) if spec else {
                         "preset": preset, "test": test["name"], "seed": seed,
                         "setting": setting, "stop_reason": "genesis failed"}
@@ -227,11 +247,12 @@ def cmd_report(args):
             ok = n >= 6 and abs(m) + h <= half
             fin = [x for x in de if math.isfinite(x)]
             fin_n = [x for x in dn if math.isfinite(x)]
-            print("| %s | %s | %s | %d | %s | %s | %+.2f %% [%+.2f, %+.2f] | %s | %.3f %% | %s |" % (
+            interval = "[%+.2f, %+.2f]" % (100 * (m - h), 100 * (m + h)) if n > 1 else "(one pair)"
+            print("| %s | %s | %s | %d | %s | %s | %+.2f %% %s | %s | %.3f %% | %s |" % (
                 preset, test, s, n,
                 "%+.3f %% max" % (100 * max(fin, key=abs)) if fin else "-",
                 "%+.4f max" % max(fin_n, key=abs) if fin_n else "-",
-                100 * m, 100 * (m - h), 100 * (m + h),
+                100 * m, interval,
                 ("yes" if ok else "no") + ("" if n >= 6 else " (fewer than 6 seeds)"),
                 100 * max(ledger) if ledger else float("nan"),
                 "%+.0f %%" % (100 * sum(steps) / len(steps)) if steps else "-"))
@@ -246,6 +267,9 @@ def main():
     r.add_argument("--seeds", default="1-6")
     r.add_argument("--set", default="0.8,1.2", help="the settings, comma-separated")
     r.add_argument("--key", default="timestep_safety", help="the loading key the setting sets")
+    r.add_argument("--card-key", default="",
+                   help="set the setting on this card key instead (genesis: each setting its own "
+                        "specimen), e.g. packing.equilibrium_ratio")
     r.add_argument("--tests", default="", help="only these suite test names")
     r.add_argument("--threads", default="1")
     r.add_argument("--rocklab", default=os.path.join(ROOT, "build", "rocklab"))
