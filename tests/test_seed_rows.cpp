@@ -112,3 +112,37 @@ TEST(SeedRows, ACampaignResumedFromASeedsFileReportsTheSameRowAsOneThatRanThemAl
   EXPECT_EQ(validation_section(rocklab::test::read_file(dir / "resumed/report.md")), reference);
   EXPECT_EQ(rocklab::test::read_file(dir / "partial.csv"), all);
 }
+
+// A stage that runs some of the file's tests (elastic: the UCS) is served by the replicate of all
+// of them at the same card and seed (each test runs on its own), here from the per-seed rows of a
+// validation that ran every test: the campaign runs nothing.
+TEST(SeedRows, TheUcsOfAReplicateOfEveryTestServesTheElasticStage) {
+  const fs::path dir = rocklab::test::scratch_root() / "seed-rows-subset";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  nlohmann::json j = tiny_validation("rows.csv");
+  j["targets"]["youngs_modulus_Pa"]["tolerance"] = 0.9; // met at the start: no step
+  j["targets"].erase("ucs_Pa");
+  j["parameters"]["flatjoint.fj_emod"] = {{"role", "modulus"}, {"bounds", {1e8, 1e12}}};
+  j["tests"].push_back({{"name", "bz"},
+                        {"test", "brazilian"},
+                        {"shape", {{"shape", "disk"}, {"diameter", 0.02}}},
+                        {"output", {{"vtk", false}, {"plots", false}}}});
+  auto run = [&](const std::string& name, const nlohmann::json& cal, std::string& said) {
+    const std::string file = (dir / (name + ".json")).string();
+    std::ofstream(file) << cal.dump(2);
+    return rocklab::test::run_command(rocklab::test::binary() + " calibrate " + file + " -o " +
+                                          (dir / name).string() + " --jobs 1",
+                                      &said);
+  };
+  std::string said;
+  const int first = run("all-tests", j, said); // seed 1 and 2 fresh seeds, every test
+  ASSERT_TRUE(first == 0 || first == 1) << said;
+  j["budget"]["elastic"] = 1; // now an elastic stage (the UCS alone) before the final evaluation
+  j["budget"]["max_seeds"] = 1;
+  const int second = run("elastic", j, said);
+  ASSERT_TRUE(second == 0 || second == 1) << said;
+  EXPECT_NE(said.find("1 elastic:"), std::string::npos) << said;
+  EXPECT_NE(said.find("1 seed(s), 1 cached"), std::string::npos) << said;
+  EXPECT_NE(said.find("(0 suites run"), std::string::npos) << said;
+}

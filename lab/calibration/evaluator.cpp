@@ -162,6 +162,28 @@ bool Evaluator::add_seed(int max_seeds) {
   return true;
 }
 
+// A finished folder serves, or else a per-seed row (another run's); a folder whose test rejected
+// its input is run again whatever a row says (the row is older than that verdict). A stage that
+// runs some of the file's tests (elastic, strength: the UCS) is served as well by the replicate
+// of all of them at the same card and seed: each test is its own process on its own specimen, so
+// its results do not depend on the tests run beside it (after a validation whose seeds join the
+// tuned ones, the next stage finds their UCS there instead of running it again).
+fs::path Evaluator::cached_source(const Replicate& r, const nlohmann::json*& row) const {
+  row = nullptr;
+  for (const auto& [dir, key] : {std::pair{r.dir, r.key}, std::pair{r.all_dir, r.all_key}}) {
+    if (key.empty())
+      continue;
+    const bool folder = fs::exists(dir / "suite" / "summary.json");
+    if (reusable(dir / "suite"))
+      return dir / "suite";
+    if (!folder && (row = rows_.find(key)))
+      return rows_.path() + " (row " + key + ")";
+    if (folder && key == r.key)
+      return {}; // its own test rejected its input: run it again
+  }
+  return {};
+}
+
 void Evaluator::adopt_seeds(const std::vector<std::uint64_t>& seeds) {
   for (std::uint64_t s : seeds)
     if (std::find(seeds_.begin(), seeds_.end(), s) == seeds_.end())
@@ -180,30 +202,40 @@ Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
   const nlohmann::json stage_tests = tests_of(s);
   // The cache key: everything the result depends on, with the revision of each test's measurement
   // rules where it was raised (older keys stay valid for the other tests).
-  std::string revisions;
-  for (const auto& t : stage_tests)
-    if (const auto p = make_lab_protocol(t.value("test", "")); p && p->revision() > 1) {
-      revisions += '|';
-      revisions += p->name();
-      revisions += " r" + std::to_string(p->revision());
-    }
-  std::vector<Replicate> reps;
-  for (std::uint64_t seed : seeds) {
-    nlohmann::json ts = stage_tests;
+  auto key_of = [&](const nlohmann::json& tests, std::uint64_t seed, nlohmann::json& ts) {
+    std::string revisions;
+    for (const auto& t : tests)
+      if (const auto p = make_lab_protocol(t.value("test", "")); p && p->revision() > 1) {
+        revisions += '|';
+        revisions += p->name();
+        revisions += " r" + std::to_string(p->revision());
+      }
+    ts = tests;
     for (auto& t : ts)
       t["seed"] = seed;
-    const std::string key =
-        text_hash(card.dump() + "|" + ts.dump() + "|" + ROCKLAB_VERSION + revisions).substr(0, 16);
-    reps.push_back({fs::path(o_.out_dir) / "evaluations" / key, ts, key, seed});
+    return text_hash(card.dump() + "|" + ts.dump() + "|" + ROCKLAB_VERSION + revisions)
+        .substr(0, 16);
+  };
+  const fs::path evaluations = fs::path(o_.out_dir) / "evaluations";
+  std::vector<Replicate> reps;
+  for (std::uint64_t seed : seeds) {
+    Replicate r;
+    r.seed = seed;
+    r.key = key_of(stage_tests, seed, r.tests);
+    r.dir = evaluations / r.key;
+    if (stage_tests != c_.tests) { // each test runs on its own: the full set's results serve
+      nlohmann::json all;
+      r.all_key = key_of(c_.tests, seed, all);
+      r.all_dir = evaluations / r.all_key;
+    }
+    reps.push_back(std::move(r));
   }
   // Which replicates are cached is decided once (rank 0) so that every rank shares out the same
   // list; this rank runs every size-th of the missing ones.
   std::string missing;
-  // A finished folder serves, or else a per-seed row (another run's); a folder whose test rejected
-  // its input is run again whatever a row says (the row is older than that verdict).
   for (const Replicate& r : reps) {
-    const bool folder = fs::exists(r.dir / "suite" / "summary.json");
-    missing += reusable(r.dir / "suite") || (!folder && rows_.find(r.key)) ? '0' : '1';
+    const nlohmann::json* row = nullptr;
+    missing += cached_source(r, row).empty() ? '1' : '0';
   }
   const Ranks* ranks = o_.ranks;
   if (ranks)
@@ -238,17 +270,20 @@ Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
   std::map<std::string, std::vector<double>> all;
   for (std::size_t i = 0; i < reps.size(); ++i) {
     (missing[i] == '1' ? run_ : ev.cached) += 1;
-    const fs::path suite_out = reps[i].dir / "suite";
+    const nlohmann::json* row = nullptr;
+    fs::path suite_out = cached_source(reps[i], row);
+    if (suite_out.empty()) // it ran and its test rejected its input: check_tests says so
+      suite_out = reps[i].dir / "suite";
+    ev.folders.push_back(suite_out.string());
     nlohmann::json props;
-    if (const nlohmann::json* row = rows_.find(reps[i].key); row && !reusable(suite_out)) {
-      ev.folders.push_back(rows_.path() + " (row " + reps[i].key + ")");
+    if (row) {
       props = *row;
     } else {
-      ev.folders.push_back(suite_out.string());
       const nlohmann::json sm = read_json_file((suite_out / "summary.json").string(), Nulls::Allow);
       check_tests(sm, suite_out, reps[i].tests);
       props = sm["properties"];
-      if ((!ranks || ranks->rank() == 0) && !row)
+      const bool own = suite_out == reps[i].dir / "suite";
+      if ((!ranks || ranks->rank() == 0) && own && !rows_.find(reps[i].key))
         rows_.add(reps[i].key, reps[i].seed, props); // a cached folder's row
     }
     // The share of the seed's disks that were valid, and how many it had (lab/protocols/brazilian).

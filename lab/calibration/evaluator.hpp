@@ -78,7 +78,14 @@ private:
     nlohmann::json tests;
     std::string key; ///< the cache key (the per-seed row's key)
     std::uint64_t seed = 0;
+    /// For a stage that runs some of the file's tests: the replicate of all of them (same card
+    /// and seed), whose results serve it too (empty: the stage runs all of them).
+    std::filesystem::path all_dir;
+    std::string all_key;
   };
+  /// Where a replicate's properties are without running it: "" (run it), else the summary.json
+  /// folder or, with `row` set, a per-seed row.
+  std::filesystem::path cached_source(const Replicate& r, const nlohmann::json*& row) const;
   /// Runs the suites of these replicates, up to `jobs` test processes at once in all.
   void run_suites(const nlohmann::json& card, const std::vector<const Replicate*>& todo);
   void check_tests(const nlohmann::json& summary, const std::filesystem::path& suite_out,

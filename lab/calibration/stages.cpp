@@ -281,11 +281,13 @@ void Campaign::confirm() {
       std::string need = "more than one seed";
       if (std::isfinite(se) && std::isfinite(n))
         need = "about " + num(std::ceil(n * (se / half) * (se / half))) + " seeds";
+      const std::string why =
+          std::isfinite(se)
+              ? "its standard error " + num(se) + " is above half its tolerance (" + num(half) + ")"
+              : std::string("one seed gives no standard error");
       out.notes.push_back(t->property + " " + num(value_of(out.measured, t->property)) +
-                          " is within its tolerance of " + num(t->value) +
-                          " but not confirmed: its standard error " + num(se) +
-                          " is above half its tolerance (" + num(half) + "); it needs " + need +
-                          ", more than the budget's");
+                          " is within its tolerance of " + num(t->value) + " but not confirmed: " +
+                          why + "; it needs " + need + ", more than the budget's");
     }
     return;
   }
