@@ -341,8 +341,7 @@ public:
     // arc's factor, printed and in results.json.
     if (split.contains("stress_Pa") && split["stress_Pa"] != split["peak_Pa"])
       m.push_back({100 * r["peak_axial_strain"].get<double>(),
-                   1e-6 * split["stress_Pa"].get<double>(),
-                   "tensile strength (before the split)"});
+                   1e-6 * split["stress_Pa"].get<double>(), "tensile strength (before the split)"});
   }
   void save(nlohmann::json& state) const override {
     nlohmann::json t = nlohmann::json::array();
