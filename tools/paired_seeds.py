@@ -204,17 +204,18 @@ def cmd_report(args):
     for r in rows:
         groups.setdefault((r["preset"], r["test"]), {}).setdefault(r["seed"], {})[r["setting"]] = r
     print("| preset | test | setting | seeds | E shift (same window) | nu shift | strength shift, mean "
-          "[95 % interval] | within +-half tolerance | largest ledger error | loading steps |")
+          "[95 % interval] | within +-half tolerance | largest ledger error (at the base) | loading steps |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for (preset, test), by_seed in sorted(groups.items()):
         settings = sorted({s for d in by_seed.values() for s in d if s != base}, key=float)
         for s in settings:
-            de, dn, ds, ledger, steps = [], [], [], [], []
+            de, dn, ds, ledger, ledger0, steps = [], [], [], [], [], []
             for seed, d in by_seed.items():
                 if base not in d or s not in d:
                     continue
                 a, b = d[base], d[s]
                 ledger.append(num(b["ledger_error"]))
+                ledger0.append(num(a["ledger_error"]))
                 if num(a["loading_steps"]) > 0:
                     steps.append(num(b["loading_steps"]) / num(a["loading_steps"]) - 1)
                 if num(a["youngs_modulus_Pa"]) > 0:
@@ -248,13 +249,14 @@ def cmd_report(args):
             fin = [x for x in de if math.isfinite(x)]
             fin_n = [x for x in dn if math.isfinite(x)]
             interval = "[%+.2f, %+.2f]" % (100 * (m - h), 100 * (m + h)) if n > 1 else "(one pair)"
-            print("| %s | %s | %s | %d | %s | %s | %+.2f %% %s | %s | %.3f %% | %s |" % (
+            print("| %s | %s | %s | %d | %s | %s | %+.2f %% %s | %s | %.3f %% (%.3f %%) | %s |" % (
                 preset, test, s, n,
                 "%+.3f %% max" % (100 * max(fin, key=abs)) if fin else "-",
                 "%+.4f max" % max(fin_n, key=abs) if fin_n else "-",
                 100 * m, interval,
                 ("yes" if ok else "no") + ("" if n >= 6 else " (fewer than 6 seeds)"),
                 100 * max(ledger) if ledger else float("nan"),
+                100 * max(ledger0) if ledger0 else float("nan"),
                 "%+.0f %%" % (100 * sum(steps) / len(steps)) if steps else "-"))
 
 
