@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Paired-seed comparison of a change of the dynamics (docs/results.md, "The rule for a change of
 the dynamics"): each preset's suite tests (UCS, Brazilian) on the same specimens, once per
-setting (e.g. loading.timestep_safety 0.8 and 1.2), one CSV row per (preset, test, seed, setting).
+setting (e.g. loading.timestep_safety 0.8 and 1.2), one CSV row per (preset, test, seed, setting);
+the tests are the suite's strength tests (UCS, Brazilian, direct tension).
 Resumable: rows already in OUT/rows.csv are not run again, and each finished row is appended at
 once, so a run longer than a session continues where it stopped (the rows are small: commit them).
 
@@ -36,7 +37,7 @@ def suite_tests(preset):
     material = os.path.normpath(os.path.join(ROOT, "lab", "suites", suite["material"]))
     if card:
         material = os.path.join(ROOT, "materials", card + ".json")
-    return material, [t for t in suite["tests"] if t["test"] in ("ucs", "brazilian")]
+    return material, [t for t in suite["tests"] if t["test"] in HALF_TOLERANCE]
 
 
 def seeds_of(text):
@@ -78,7 +79,10 @@ def card_for(args, material, setting):
 
 
 def specimen(args, material, test, seed):
-    name = "%s_%s_%d.rlspec" % (os.path.basename(material)[:-5], test["name"], seed)
+    # Tests on the card's own specimen shape (UCS, direct tension) share one specimen per seed.
+    shaped = "shape" in test or "cut" in test
+    name = "%s_%s_%d.rlspec" % (os.path.basename(material)[:-5], test["name"] if shaped else "ucs",
+                                seed)
     path = os.path.join(args.out, "specimens", name)
     if not os.path.exists(path):
         os.makedirs(os.path.dirname(path), exist_ok=True)
