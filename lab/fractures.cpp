@@ -10,69 +10,12 @@
 
 namespace rocklab {
 
-TouchingPairs touching_pairs(const Model& m) {
-  TouchingPairs t;
-  for (const Contact& c : m.contacts())
-    if (c.kind == ContactKind::BallBall)
-      t.emplace_back(m.balls.id[static_cast<std::size_t>(c.end1)],
-                     m.balls.id[static_cast<std::size_t>(c.end2)]);
-  return t;
-}
-
-double default_event_window(double youngs_modulus, double bulk_density, double mean_diameter,
-                            double diameters) {
-  if (!(youngs_modulus > 0) || !(bulk_density > 0) || !(mean_diameter > 0))
-    return 0;
-  return diameters * mean_diameter / std::sqrt(youngs_modulus / bulk_density);
-}
-
-EventClustering cluster_events(const std::vector<Crack>& cracks, const TouchingPairs& touching,
-                               double window) {
+EventClustering monitored_events(const std::vector<Crack>& cracks, const AeMonitor& monitor,
+                                 int dim) {
   EventClustering ev;
-  ev.window = window;
-  // Grains that touch: the model's contacts and every cracked contact (whose grains may have
-  // separated since).
-  std::unordered_map<std::int64_t, std::vector<std::int64_t>> nb;
-  auto link = [&](std::int64_t a, std::int64_t b) {
-    if (a < 0 || b < 0)
-      return;
-    nb[a].push_back(b);
-    nb[b].push_back(a);
-  };
-  for (const auto& [a, b] : touching)
-    link(a, b);
-  for (const Crack& c : cracks)
-    link(c.ball1, c.ball2);
-  // The latest crack at each grain: (event, time).
-  std::unordered_map<std::int64_t, std::pair<int, double>> last;
-  ev.event_of_crack.reserve(cracks.size());
-  for (const Crack& c : cracks) {
-    int join = -1;
-    auto look = [&](std::int64_t g) {
-      const auto it = last.find(g);
-      if (it != last.end() && it->second.second >= c.time - window &&
-          (join < 0 || it->second.first < join))
-        join = it->second.first;
-    };
-    for (const std::int64_t g : {c.ball1, c.ball2}) {
-      if (g < 0)
-        continue;
-      look(g);
-      const auto it = nb.find(g);
-      if (it != nb.end())
-        for (const std::int64_t h : it->second)
-          look(h);
-    }
-    if (join < 0) {
-      join = static_cast<int>(ev.events.size());
-      ev.events.push_back({});
-      ev.events.back().id = join;
-    }
-    ev.event_of_crack.push_back(join);
-    for (const std::int64_t g : {c.ball1, c.ball2})
-      if (g >= 0)
-        last[g] = {join, c.time};
-  }
+  ev.event_of_crack = monitor.event_of_crack();
+  ev.sources = monitor.sources();
+  ev.dim = dim;
   ev.events = events_until(cracks, ev, INFINITY);
   return ev;
 }
@@ -80,8 +23,11 @@ EventClustering cluster_events(const std::vector<Crack>& cracks, const TouchingP
 std::vector<FractureEvent> events_until(const std::vector<Crack>& cracks, const EventClustering& ev,
                                         double until) {
   std::vector<FractureEvent> out;
-  std::vector<int> index(ev.events.size(), -1); // event id -> position in out
-  std::vector<std::vector<std::uint64_t>> contacts(ev.events.size());
+  int ids = 0;
+  for (const int id : ev.event_of_crack)
+    ids = std::max(ids, id + 1);
+  std::vector<int> index(static_cast<std::size_t>(ids), -1); // event id -> position in out
+  std::vector<std::vector<std::uint64_t>> contacts(static_cast<std::size_t>(ids));
   for (std::size_t i = 0; i < cracks.size() && i < ev.event_of_crack.size(); ++i) {
     const Crack& c = cracks[i];
     if (c.time > until)
@@ -107,6 +53,12 @@ std::vector<FractureEvent> events_until(const std::vector<Crack>& cracks, const 
     std::sort(k.begin(), k.end());
     e.contacts = static_cast<int>(std::unique(k.begin(), k.end()) - k.begin());
     e.magnitude = e.energy > 0 ? (std::log10(e.energy) - 4.8) / 1.5 : NAN;
+    if (static_cast<std::size_t>(e.id) < ev.sources.size() &&
+        ev.sources[static_cast<std::size_t>(e.id)].m0 > 0) {
+      e.has_source = true;
+      e.tensor = ev.sources[static_cast<std::size_t>(e.id)].tensor;
+      e.source = read_source(e.tensor, ev.dim);
+    }
   }
   return out;
 }
@@ -151,7 +103,10 @@ std::vector<ContactCrack> contact_cracks(const std::vector<Crack>& cracks,
 
 void write_events_csv(std::ostream& out, const std::vector<FractureEvent>& events) {
   out << "event,time_s,duration_s,x_m,y_m,z_m,cracks,contacts,tension,shear,energy_J,"
-         "magnitude\n";
+         "magnitude,m0_Nm,moment_magnitude,source_type,r_feignier_young,isotropic,double_couple,"
+         "clvd,t_axis_x,t_axis_y,t_axis_z,p_axis_x,p_axis_y,p_axis_z,m_xx_Nm,m_yy_Nm,m_zz_Nm,"
+         "m_xy_Nm,m_yz_Nm,m_zx_Nm\n";
+  auto num = [](double v) { return std::isfinite(v) ? format_double(v) : std::string(); };
   std::string s; // one row at a time
   for (const FractureEvent& e : events) {
     s = std::to_string(e.id) + ',' + format_double(e.time) + ',' + format_double(e.duration);
@@ -159,7 +114,21 @@ void write_events_csv(std::ostream& out, const std::vector<FractureEvent>& event
       s += ',' + format_double(e.position[k]);
     s += ',' + std::to_string(e.cracks) + ',' + std::to_string(e.contacts) + ',' +
          std::to_string(e.tension) + ',' + std::to_string(e.shear) + ',' + format_double(e.energy) +
-         ',' + (std::isfinite(e.magnitude) ? format_double(e.magnitude) : "") + '\n';
+         ',' + num(e.magnitude);
+    if (e.has_source) {
+      const SourceReading& r = e.source;
+      s += ',' + num(r.m0) + ',' + num(r.mw) + ',' + to_string(r.type) + ',' + num(r.r) + ',' +
+           num(r.isotropic) + ',' + num(r.double_couple) + ',' + num(r.clvd);
+      for (const Vec3& a : {r.t_axis, r.p_axis})
+        for (int k = 0; k < 3; ++k)
+          s += ',' + num(a[k]);
+      const Mat3& m = e.tensor;
+      for (const double v : {m(0, 0), m(1, 1), m(2, 2), m(0, 1), m(1, 2), m(2, 0)})
+        s += ',' + num(v);
+    } else {
+      s += std::string(19, ',');
+    }
+    s += '\n';
     out << s;
   }
 }

@@ -1,10 +1,10 @@
 // From crack records to what a rock engineer reads: one crack per broken contact (its damage =
-// broken parts / parts; a flat joint's elements become one crack) and fracture events, cracks
-// clustered in space and time in the acoustic-emission manner of Hazzard & Young (2000): a crack
-// joins an event when one of its grains is, or touches, a grain of a crack of that event that
-// formed no longer than the event window before it. Units SI.
+// broken parts / parts; a flat joint's elements become one crack) and fracture (acoustic-emission)
+// events, formed while the test runs by lab/ae_monitor (Hazzard & Young 2000, 2004), with their
+// sources' moment tensors. Units SI.
 #pragma once
 
+#include "lab/ae_monitor.hpp"
 #include "lab/crack_monitor.hpp"
 
 #include <iosfwd>
@@ -38,29 +38,25 @@ struct FractureEvent {
   double duration = 0;          ///< last crack - first crack [s]
   Vec3 position = Vec3::Zero(); ///< centroid of its cracks [m]
   int cracks = 0, contacts = 0, tension = 0, shear = 0;
-  double energy = 0;    ///< strain energy released by its cracks [J]
-  double magnitude = 0; ///< energy magnitude (log10 E = 1.5 M + 4.8, E in J)
+  double energy = 0;          ///< strain energy released by its cracks [J]
+  double magnitude = 0;       ///< energy magnitude (log10 E = 1.5 M + 4.8, E in J)
+  bool has_source = false;    ///< its moment tensor was followed (lab/ae_monitor)
+  Mat3 tensor = Mat3::Zero(); ///< moment tensor at its largest scalar moment [N m]
+  SourceReading source;       ///< what that tensor reads (M0, Mw, type, axes)
 };
 
+/// The events of a test's cracks: which event each crack record belongs to (from the
+/// AeMonitor), their sources by event id, and the events with everything summed.
 struct EventClustering {
-  double window = 0;               ///< [s]
   std::vector<int> event_of_crack; ///< per crack record
+  std::vector<AeSource> sources;   ///< by event id (empty: no moment tensors)
+  int dim = 3;
   std::vector<FractureEvent> events;
 };
 
-/// Pairs of grain ids that touch (contacts of the model, bonded or not).
-using TouchingPairs = std::vector<std::pair<std::int64_t, std::int64_t>>;
-TouchingPairs touching_pairs(const Model& m);
-
-/// Cluster the cracks (in record order, which is time order) into events. Causal: a crack only
-/// looks back, so the events up to a time never change when later cracks come.
-EventClustering cluster_events(const std::vector<Crack>& cracks, const TouchingPairs& touching,
-                               double window);
-
-/// The default window: the time a P wave, speed sqrt(E / rho) with the test's modulus and the
-/// specimen's bulk density, takes to cross `diameters` mean grain diameters.
-double default_event_window(double youngs_modulus, double bulk_density, double mean_diameter,
-                            double diameters = 5);
+/// The events of `cracks` as `monitor` formed them.
+EventClustering monitored_events(const std::vector<Crack>& cracks, const AeMonitor& monitor,
+                                 int dim);
 
 /// The broken contacts as of `until` (cracks with time <= until), in order of first break. Size:
 /// 3D the diameter of the summed crack area, 2D the summed length.
@@ -71,7 +67,7 @@ std::vector<ContactCrack> contact_cracks(const std::vector<Crack>& cracks,
 std::vector<FractureEvent> events_until(const std::vector<Crack>& cracks, const EventClustering& ev,
                                         double until);
 
-/// events.csv: one row per event, SI units.
+/// events.csv: one row per event, SI units (tensors in N m; 2D per metre of thickness).
 void write_events_csv(std::ostream& out, const std::vector<FractureEvent>& events);
 
 } // namespace rocklab

@@ -5,6 +5,7 @@
 #include "io/progress.hpp"
 #include "io/results.hpp"
 #include "io/specimen.hpp"
+#include "lab/ae_report.hpp"
 #include "lab/frame_snapshot.hpp"
 #include "lab/protocol_table.hpp"
 #include "lab/protocols/frame_protocol.hpp"
@@ -228,7 +229,18 @@ std::vector<PlotMarker> crack_markers(const FrameTest& test, const LoadingFrame&
 /// the final state (made while the model exists; rendered and written after it is freed).
 struct PlotDocuments {
   std::string stress_strain, crack_map;
+  std::string magnitude_frequency, acoustic_emission; ///< "" without moment tensors
 };
+
+LoadCurve load_curve(const LoadingFrame& f, const PlotLabels& labels) {
+  LoadCurve c{{}, {}, {}, labels.curve, labels.x, labels.y};
+  for (const LabSample& s : f.samples()) {
+    c.time.push_back(s.time);
+    c.strain_pct.push_back(100 * s.axial_strain);
+    c.stress_mpa.push_back(1e-6 * s.axial_stress);
+  }
+  return c;
+}
 
 PlotDocuments plot_documents(const FrameTest& test, const LoadingFrame& f,
                              const nlohmann::json& meta, const nlohmann::json& r,
@@ -273,7 +285,9 @@ PlotDocuments plot_documents(const FrameTest& test, const LoadingFrame& f,
   add_fractures(final, f.cracks().cracks(), ev, INFINITY);
   return {
       line_plot_svg(title, labels.x, labels.y, "cracks", series, crack_markers(test, f, r)),
-      crack_map_svg(final, title + ", cracks at the end", labels.map_axis, f.geometry().diametral)};
+      crack_map_svg(final, title + ", cracks at the end", labels.map_axis, f.geometry().diametral),
+      magnitude_frequency_svg(ev.events, title + ", magnitude-frequency of the acoustic emission"),
+      acoustic_emission_svg(load_curve(f, labels), ev.events, title)};
 }
 
 void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::time_point t0) {
@@ -337,11 +351,19 @@ void FrameRun::write_outputs(const FrameTest& test, std::chrono::steady_clock::t
   vtk.reset();
   frame.reset();
   model.reset();
-  if (p.plots)
+  if (p.plots) {
     for (const auto& [svg, png] :
          {write_svg_and_png(out.staged("stress_strain.svg"), plots.stress_strain),
           write_svg_and_png(out.staged("crack_map.svg"), plots.crack_map)})
       sum.files.insert(sum.files.end(), {svg, png});
+    for (const auto& [name, doc] : {std::pair<std::string, const std::string*>{
+                                        "magnitude_frequency.svg", &plots.magnitude_frequency},
+                                    {"acoustic_emission.svg", &plots.acoustic_emission}})
+      if (!doc->empty()) {
+        const auto [svg, png] = write_svg_and_png(out.staged(name), *doc);
+        sum.files.insert(sum.files.end(), {svg, png});
+      }
+  }
   r["files"] = sum.files;
   sum.results = r;
   write_text_file(out.staged("results.json"), r.dump(2) + "\n");
@@ -419,11 +441,12 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
               static_cast<long long>(c["at_peak"]["total"].get<std::int64_t>()));
   if (r.contains("fracture_events")) {
     const auto& e = r["fracture_events"];
-    std::printf("fractures    %zu broken contacts in %zu events (largest %zu cracks; window %.3g s)"
-                "\n",
+    std::printf("fractures    %zu broken contacts in %zu events (largest %zu cracks)\n",
                 e["broken_contacts"].get<std::size_t>(), e["count"].get<std::size_t>(),
-                e["largest_event_cracks"].get<std::size_t>(), e["window_s"].get<double>());
+                e["largest_event_cracks"].get<std::size_t>());
   }
+  if (r.contains("acoustic_emission"))
+    print_acoustic_emission(r["acoustic_emission"]);
   std::printf("stopped      %s\n", r["stop_reason"].get<std::string>().c_str());
   std::printf("wall time    %.1f s on %d thread(s)\n", s.wall_seconds, omp_get_max_threads());
   std::printf("results      %s/results.json  %s/history.csv  %s/cracks.csv  %s/events.csv\n",

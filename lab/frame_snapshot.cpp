@@ -1,6 +1,7 @@
 #include "lab/frame_snapshot.hpp"
 
 #include "io/results.hpp"
+#include "lab/ae_report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -63,34 +64,32 @@ void add_fractures(Snapshot& s, const std::vector<Crack>& cracks, const EventClu
 }
 
 EventClustering fracture_events(const LoadingFrame& f, const Protocol& p, nlohmann::json& r) {
-  const Balls& b = f.model().balls;
-  double rsum = 0, rho = 0;
-  for (std::size_t i = 0; i < b.size(); ++i)
-    rsum += b.radius[i], rho += b.density[i];
-  const double n = std::max<double>(1, static_cast<double>(b.size()));
-  double e = json_number(r, "youngs_modulus_Pa", 0.0); // null where E could not be fitted
-  std::string method = "output.event_window_s";
-  double window = p.event_window;
-  if (!(window > 0)) {
-    if (!(e > 0) && json_number(r, "peak_axial_strain", 0.0) > 0) // no fit: the peak secant
-      e = json_number(r, "peak_stress_Pa", 0.0) / json_number(r, "peak_axial_strain", 1.0);
-    window = default_event_window(e, rho / n, 2 * rsum / n);
-    method = "5 mean grain diameters / P-wave speed sqrt(E / grain density)";
-  }
-  EventClustering ev = cluster_events(f.cracks().cracks(), touching_pairs(f.model()), window);
+  const AeMonitor& ae = f.acoustic_emission();
+  const int dim = f.model().settings.dim;
+  EventClustering ev = monitored_events(f.cracks().cracks(), ae, dim);
   std::size_t largest = 0;
   for (const FractureEvent& x : ev.events)
     largest = std::max(largest, static_cast<std::size_t>(x.cracks));
+  const std::string duration =
+      p.event_window > 0
+          ? "output.event_window_s: each crack keeps its event open " +
+                format_double(p.event_window) + " s"
+          : "each crack keeps its event open while a rupture at half the shear-wave speed "
+            "crosses the crack's larger grain (Hazzard & Young 2000); the speed sqrt(G / rho), G "
+            "the affine shear modulus of the grain contacts and rho the grains' mass over the "
+            "specimen's volume at the first crack";
   r["fracture_events"] = {
       {"count", ev.events.size()},
-      {"broken_contacts",
-       contact_cracks(f.cracks().cracks(), ev, INFINITY, f.model().settings.dim).size()},
-      {"window_s", window},
-      {"window_method", method},
+      {"broken_contacts", contact_cracks(f.cracks().cracks(), ev, INFINITY, dim).size()},
       {"largest_event_cracks", largest},
-      {"method", "a crack joins the event of a crack at the same or a touching grain formed at "
-                 "most window_s before it (after Hazzard & Young 2000); magnitude: log10 E = "
-                 "1.5 M + 4.8 of the released bond strain energy E [J]"}};
+      {"shear_wave_speed_m_per_s", ae.shear_wave_speed()},
+      {"duration_rule", duration},
+      {"method", "a crack joins the open event whose source grains (the grains of its cracks) it "
+                 "shares or touches, else opens one (Hazzard & Young 2000, 2004); magnitude: "
+                 "log10 E = 1.5 M + 4.8 of the released bond strain energy E [J]"}};
+  if (p.moment_tensors)
+    r["acoustic_emission"] =
+        acoustic_emission_summary(ev.events, json_number(r, "peak_time_s", NAN));
   return ev;
 }
 

@@ -138,6 +138,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
     p.orientation = o.boolean("orientation", false);
     p.cells = o.boolean("cells", true);
     p.event_window = o.number("event_window_s", Range::non_negative(), 0.0);
+    p.moment_tensors = o.boolean("moment_tensors", true);
     o.finish();
   }
   top.finish();

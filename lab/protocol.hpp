@@ -57,10 +57,10 @@ struct Protocol {
   bool plots = true;                ///< write the SVG stress-strain plot and crack map
   bool orientation = false;         ///< track grain rotation from the loading on (ParaView)
   bool cells = true;                ///< ParaView: the grains' power cells and crack faces
-  double event_window =
-      0;                 ///< fracture events: crack time window [s]; 0: 5 grain diameters / P wave
-  nlohmann::json raw;    ///< the file as read
-  std::string text_hash; ///< hash of the file's text
+  double event_window = 0;    ///< how long a crack keeps its event open [s]; 0: Hazzard & Young's
+  bool moment_tensors = true; ///< follow the events' moment tensors (lab/ae_monitor)
+  nlohmann::json raw;         ///< the file as read
+  std::string text_hash;      ///< hash of the file's text
 };
 
 /// Read and validate a protocol file of a test in the loading frame; errors name the file, key,

@@ -256,7 +256,15 @@ TEST(Lab, ThreeDimensionalCylinderCracksAreDisks) {
   for (std::size_t i = 1; i < events.size(); ++i)
     in_events += std::stoll(events[i][6]);
   EXPECT_EQ(in_events, total); // every crack in one event
-  EXPECT_GT(fe["window_s"].get<double>(), 0);
+  EXPECT_GT(fe["shear_wave_speed_m_per_s"].get<double>(), 0);
+  // Every event's source was followed: events.csv has its moment magnitude and type, and the
+  // counts by type add up to the events.
+  const auto& ae = r["acoustic_emission"];
+  const auto& by = ae["by_source_type"];
+  EXPECT_EQ(by["tensile"].get<std::size_t>() + by["shear"].get<std::size_t>() +
+                by["implosive"].get<std::size_t>(),
+            ae["events_with_source"].get<std::size_t>());
+  EXPECT_GT(ae["events_with_source"].get<std::size_t>(), 0u);
   // Faced grains: the power cells fill the specimen (within 1 %: the round side is a 96-gon) and
   // every broken contact is drawn as the face its grains' cells share.
   const auto& pc = r["power_cells"];

@@ -162,6 +162,7 @@ void LoadingFrame::write_history_csv(std::ostream& out) const {
 void LoadingFrame::finish(const std::string& why) {
   stop_reason_ = why;
   phase_ = kDone;
+  ae_.finish(m_.time());
   for (Wall& w : m_.walls) {
     w.velocity.setZero();
     w.radial_velocity = 0;
@@ -178,6 +179,7 @@ void LoadingFrame::advance() {
   for (const Event& ev : events_)
     bond_break_events_ += ev.type == EventType::BondBreak ? 1 : 0;
   monitor_.consume(m_, events_);
+  ae_.step(m_, monitor_.cracks(), current_volume());
   measure(current_);
   const std::int64_t since = m_.step() - phase_start_step_;
   if (phase_ == kConfine || phase_ == kSeat) {
@@ -327,6 +329,7 @@ nlohmann::json LoadingFrame::state() const {
                        x.lateral_stress, x.load, x.force});
   s["samples"] = std::move(samples);
   s["cracks"] = monitor_.to_json();
+  s["acoustic_emission"] = ae_.to_json();
   nlohmann::json own = nlohmann::json::object();
   test_.save(own);
   s["test"] = std::move(own);
@@ -356,8 +359,9 @@ void LoadingFrame::restore(const nlohmann::json& s, const std::string& file) {
                           x.at(3).get<double>(), x.at(4).get<double>(), x.at(5).get<double>(),
                           x.at(6).get<double>(), x.at(7).get<double>()});
     monitor_.from_json(r.at("cracks"));
+    ae_.from_json(r.at("acoustic_emission"));
   } catch (const nlohmann::json::exception&) {
-    throw InputError(file + ": corrupt checkpoint (samples or cracks)");
+    throw InputError(file + ": corrupt checkpoint (samples, cracks or acoustic emission)");
   }
   test_.load(r.at("test"), file);
   m_.settings.slip_events = false;

@@ -8,6 +8,7 @@
 #pragma once
 
 #include "core/model.hpp"
+#include "lab/ae_monitor.hpp"
 #include "lab/crack_monitor.hpp"
 #include "lab/frame/fixtures.hpp"
 #include "lab/frame/geometry.hpp"
@@ -107,6 +108,8 @@ public:
   const Model& model() const { return m_; }
   const SpecimenGeometry& geometry() const { return geo_; }
   const CrackMonitor& cracks() const { return monitor_; }
+  /// The acoustic-emission events and their sources, formed while the test runs.
+  const AeMonitor& acoustic_emission() const { return ae_; }
   const std::vector<LabSample>& samples() const { return samples_; }
   const LabSample& current() const { return current_; }
   const PeakRecord& peak() const { return peak_; }
@@ -209,6 +212,7 @@ private:
   /// history.csv and results.json count energies from these.
   std::vector<double> energy_start_, energy_load_;
   CrackMonitor monitor_;
+  AeMonitor ae_;
   std::vector<Event> events_;
 };
 

@@ -23,6 +23,8 @@ LoadingFrame::LoadingFrame(const Protocol& p, FrameTest& test, Model& m, const n
 void LoadingFrame::setup() {
   m_.settings.slip_events = false; // the lab reads bond_break events only
   m_.clear_events();
+  ae_.set_duration(p_.event_window);
+  ae_.set_tensors(p_.moment_tensors);
   if (m_.balls.size() == 0)
     throw InputError(p_.file + ": the specimen has no grains");
   const FrameSetup& setup = setup_;

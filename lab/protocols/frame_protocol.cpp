@@ -43,8 +43,4 @@ void FrameTest::suite_results(const SuiteValues& v, nlohmann::json& props) const
     props[p.name] = number_or_null(v.get(p.name));
 }
 
-nlohmann::json number_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
-}
-
 } // namespace rocklab

@@ -5,6 +5,7 @@
 // run loop (lab/frame_run.cpp) do the rest. Units SI.
 #pragma once
 
+#include "io/results.hpp"
 #include "lab/frame/loading_frame.hpp"
 #include "lab/lab_protocol.hpp"
 #include "viz/svg_plots.hpp"
@@ -98,8 +99,6 @@ public:
 
 /// The stop reason of the standard post-peak rule.
 std::string load_fell_reason(const Protocol& p);
-/// A finite value as a JSON number, anything else as null (results and summaries).
-nlohmann::json number_or_null(double v);
 
 /// The printout's tensile-strength line: "tensile strength X MPa (force F N)", then `more`.
 void print_tensile_strength(const nlohmann::json& r, const std::string& more = "");

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <iosfwd>
 
 namespace rocklab {
@@ -39,6 +40,11 @@ std::string format_double(double v);
 inline double json_number(const nlohmann::json& r, const char* key, double fallback) {
   const auto it = r.find(key);
   return it != r.end() && it->is_number() ? it->get<double>() : fallback;
+}
+
+/// A finite value as a JSON number, anything else as null (a measurement that could not be made).
+inline nlohmann::json number_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
 }
 
 } // namespace rocklab
