@@ -58,9 +58,15 @@ void add_fractures(Snapshot& s, const std::vector<Crack>& cracks, const EventClu
         {c.position, c.normal, c.size, c.mode(), c.time, 0, c.damage(), c.event, c.energy});
     s.contact_crack_grains.push_back({c.ball1, c.ball2});
   }
-  for (const FractureEvent& e : events_until(cracks, ev, until))
-    s.events.push_back(
-        {e.id, e.position, e.time, e.duration, e.cracks, e.contacts, e.energy, e.magnitude});
+  for (const FractureEvent& e : events_until(cracks, ev, until)) {
+    EventGlyph g{e.id, e.position, e.time, e.duration, e.cracks, e.contacts, e.energy, e.magnitude};
+    if (e.has_source) {
+      g.moment_magnitude = e.source.mw;
+      g.source_type = static_cast<int>(e.source.type);
+      g.r = e.source.r;
+    }
+    s.events.push_back(g);
+  }
 }
 
 EventClustering fracture_events(const LoadingFrame& f, const Protocol& p, nlohmann::json& r) {

@@ -1239,7 +1239,7 @@ TEST(Lab, CheckpointResumeIsByteIdenticalAndSigintLeavesACheckpointOrNothing) {
     };
     EXPECT_EQ(strip(read_json_file((out / "results.json").string(), Nulls::Allow)).dump(),
               strip(read_json_file((full / "results.json").string(), Nulls::Allow)).dump());
-    for (const char* f : {"history.csv", "cracks.csv", "vtk/grains.pvd"})
+    for (const char* f : {"history.csv", "cracks.csv", "events.csv", "vtk/grains.pvd"})
       EXPECT_EQ(test::read_file(out / f), test::read_file(full / f)) << f;
   }
 }

@@ -10,7 +10,10 @@ Options: --at end|peak|N (the snapshot shown; default end), --color time|mode|ev
 disks instead of their faced cells), --section (the faced grains behind a vertical plane through
 the specimen's axis, seen straight on and coloured by their non-affine strain: where the rock has
 come apart), --azimuth DEG (the section plane's turn about the axis; default 0: the camera looks
-along +y), --walls (show the platens), --size WxH (pixels).
+along +y), --walls (show the platens), --events (the acoustic-emission events instead of the cracks: a
+sphere per event at its cracks' centroid, its diameter growing as 10^(Mw/2) -- a source's size at
+a constant stress drop -- with the median event half a grain diameter, coloured by source type:
+tensile, shear, implosive), --size WxH (pixels).
 
 What it draws (rocklab test writes the series, viz/README.md):
 - the grains' power cells (cells.pvd): 3D the specimen's skin, faded, so the fracture inside
@@ -41,7 +44,7 @@ from paraview.simple import (
 
 def parse(argv):
     opts = {"out": os.environ.get("ROCKLAB_OUT", "."), "png": None, "frames": None, "at": "end",
-            "color": "time", "grains": False, "walls": False, "section": False,
+            "color": "time", "grains": False, "walls": False, "section": False, "events": False,
             "azimuth": 0.0, "size": (1600, 1200)}
     args = list(argv)
     positional = []
@@ -58,7 +61,7 @@ def parse(argv):
                 opts["azimuth"] = float(v)
             else:
                 opts[a[2:]] = v
-        elif a in ("--grains", "--walls", "--section"):
+        elif a in ("--grains", "--walls", "--section", "--events"):
             opts[a[2:]] = True
         elif a.startswith("--"):
             raise SystemExit("unknown option %s (see the top of %s)" % (a, __file__))
@@ -118,9 +121,9 @@ def legend(view, lut, title, position):
     return bar
 
 
-def threshold(source, array, lo, hi):
+def threshold(source, array, lo, hi, association="CELLS"):
     t = Threshold(Input=source)
-    t.Scalars = ["CELLS", array]
+    t.Scalars = [association, array]
     try:
         t.LowerThreshold, t.UpperThreshold = lo, hi
     except AttributeError:  # ParaView < 5.10
@@ -173,6 +176,50 @@ def show_cracks(view, cracks, field, results, times, dim):
         view.UseDepthPeeling = 1
     except AttributeError:
         pass
+
+
+# Source types of events.csv / events.pvd (Feignier & Young's classes) and their colours.
+SOURCE_TYPES = [("0", "tensile", (0.89, 0.35, 0.05)), ("1", "shear", (0.12, 0.35, 0.85)),
+                ("2", "implosive", (0.15, 0.6, 0.2))]
+
+
+def point_values(source, array, t):
+    """A point array at time t as a numpy array (empty where missing)."""
+    import numpy as np
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    source.UpdatePipeline(t)
+    data = servermanager.Fetch(source)
+    a = data.GetPointData().GetArray(array) if data is not None else None
+    return vtk_to_numpy(a) if a is not None else np.zeros(0)
+
+
+def show_events(view, events, grains, times):
+    """The acoustic-emission events with a source, as spheres sized by their moment magnitude
+    and coloured by their source type."""
+    import numpy as np
+    t = times[-1] if times else None
+    mw = point_values(events, "moment_magnitude", t)
+    mw = mw[np.isfinite(mw)]
+    if mw.size == 0:
+        print("no events with a moment tensor in this folder")
+        return
+    radius = point_values(grains, "radius", t)
+    diameter = float(np.median(radius)) if radius.size else 5e-4  # the median event: half a grain
+    size = Calculator(Input=threshold(events, "source_type", 0, 2, "POINTS"))
+    size.AttributeType = "Point Data"
+    size.ResultArrayName = "event_diameter_m"
+    size.Function = "%.17g * 10^((moment_magnitude - %.17g) / 2)" % (diameter, np.median(mw))
+    glyph = Glyph(Input=size, GlyphType="Sphere")
+    glyph.ScaleArray = ["POINTS", "event_diameter_m"]
+    glyph.ScaleFactor = 1.0
+    glyph.GlyphMode = "All Points"
+    gd = Show(glyph, view)
+    ColorBy(gd, ("POINTS", "source_type"))
+    lut = GetColorTransferFunction("source_type")
+    lut.InterpretValuesAsCategories = 1
+    lut.Annotations = [x for v, name, _ in SOURCE_TYPES for x in (v, name)]
+    lut.IndexedColors = [c for _, _, rgb in SOURCE_TYPES for c in rgb]
+    legend(view, lut, "event source type\n(sphere size: Mw, median = half a grain)", [0.12, 0.08])
 
 
 # The section's colour scale ends at this percentile of the grains' faces: the few grains spalled
@@ -306,7 +353,13 @@ def main(argv):
         show_grains(view, grains, cells, times, dim, o["grains"])
     Hide(grains, view)
 
-    if cracks is not None and not section:
+    if o["events"]:
+        events = reader("events")
+        if events is None:
+            raise SystemExit("--events needs %s/events.pvd (rocklab test with output.vtk)"
+                             % vtk_dir)
+        show_events(view, events, grains, times)
+    elif cracks is not None and not section:
         show_cracks(view, cracks, o["color"], results, times, dim)
 
     if o["walls"]:

@@ -133,13 +133,15 @@ void write_cracks(const std::vector<CrackGlyph>& cracks, const Snapshot& frame, 
                     });
 }
 
-// Fracture events: one vertex per event at the centroid of its cracks.
+// Fracture events: one vertex per event at the centroid of its cracks; their sources' moment
+// magnitude, type and R also as point data, for glyphs.
 void write_events(const std::vector<EventGlyph>& events, const Snapshot& frame,
                   const std::filesystem::path& path) {
   PolyBuilder b;
   add_frame_fields(b.pd, frame);
   std::vector<std::int32_t> id, cracks, contacts;
-  std::vector<double> time, duration, energy, magnitude;
+  std::vector<double> time, duration, energy, magnitude, mw, r;
+  std::vector<std::int32_t> type;
   vtkNew<vtkCellArray> verts;
   for (const EventGlyph& e : events) {
     const vtkIdType p = b.point(e.position);
@@ -151,6 +153,9 @@ void write_events(const std::vector<EventGlyph>& events, const Snapshot& frame,
     duration.push_back(e.duration);
     energy.push_back(e.energy);
     magnitude.push_back(e.magnitude);
+    mw.push_back(e.moment_magnitude);
+    type.push_back(e.source_type);
+    r.push_back(e.r);
   }
   b.cell_array<std::int32_t, vtkIntArray>("event", id);
   b.cell_array<std::int32_t, vtkIntArray>("cracks", cracks);
@@ -159,6 +164,9 @@ void write_events(const std::vector<EventGlyph>& events, const Snapshot& frame,
   b.cell_array<double, vtkDoubleArray>("duration", duration);
   b.cell_array<double, vtkDoubleArray>("energy", energy);
   b.cell_array<double, vtkDoubleArray>("magnitude", magnitude);
+  b.point_array<double, vtkDoubleArray>("moment_magnitude", mw);
+  b.point_array<std::int32_t, vtkIntArray>("source_type", type);
+  b.point_array<double, vtkDoubleArray>("r_feignier_young", r);
   b.pd->SetPoints(b.pts);
   b.pd->SetVerts(verts);
   write_poly(b.pd, path);

@@ -3,6 +3,8 @@
 // All coordinates and fields SI.
 #pragma once
 
+#include <cmath>
+
 #include "core/model.hpp"
 #include "viz/power_cells.hpp"
 
@@ -35,8 +37,11 @@ struct EventGlyph {
   Vec3 position = Vec3::Zero();  ///< [m]
   double time = 0, duration = 0; ///< [s]
   int cracks = 0, contacts = 0;
-  double energy = 0;    ///< [J]
-  double magnitude = 0; ///< energy magnitude
+  double energy = 0;             ///< [J]
+  double magnitude = 0;          ///< energy magnitude
+  double moment_magnitude = NAN; ///< Mw of its moment tensor (NaN: none followed)
+  int source_type = -1;          ///< 0 tensile, 1 shear, 2 implosive (Feignier & Young), -1 none
+  double r = NAN;                ///< Feignier & Young's R [-]
 };
 
 /// What one snapshot shows: copied out of the model, so it can be written later.

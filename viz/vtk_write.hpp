@@ -11,6 +11,7 @@
 #include <vtkFieldData.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
+#include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataWriter.h>
@@ -97,6 +98,9 @@ struct PolyBuilder {
   }
   template <class T, class Arr> void cell_array(const char* name, const std::vector<T>& v) {
     pd->GetCellData()->AddArray(scalar_array<T, Arr>(name, v));
+  }
+  template <class T, class Arr> void point_array(const char* name, const std::vector<T>& v) {
+    pd->GetPointData()->AddArray(scalar_array<T, Arr>(name, v));
   }
 };
 

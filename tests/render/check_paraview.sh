@@ -2,8 +2,8 @@
 # The ParaView set-up under test (issue 14): a small 3D flat-jointed UCS is run with the built
 # rocklab, viz/rocklab_paraview.py renders its end headless with ParaView's own pvbatch, and
 # check_png.py checks the picture (drawn, specimen filling the frame, cracks, legends), and the
-# same for its --section view. Run by .ci/run after the README's test command (needs
-# build/rocklab). Units of the run: SI.
+# same for its --section view and its --events view (the acoustic-emission events as spheres).
+# Run by .ci/run after the README's test command (needs build/rocklab). Units of the run: SI.
 #
 # Debian's python3-paraview conflicts with python3-vtk9 (pulled in by libvtk9-dev), so this
 # installs paraview and unpacks python3-paraview into a folder of its own; pvbatch needs an X
@@ -36,4 +36,6 @@ xvfb-run -a -s "-screen 0 1600x1200x24 -noreset" bash -c '
   pvbatch viz/rocklab_paraview.py "$out/ucs" --png "$png" --size 1200x900
   pvbatch tests/render/check_png.py "$png"
   pvbatch viz/rocklab_paraview.py "$out/ucs" --section --png "$out/section.png" --size 1200x900
-  pvbatch tests/render/check_png.py "$out/section.png"'
+  pvbatch tests/render/check_png.py "$out/section.png"
+  pvbatch viz/rocklab_paraview.py "$out/ucs" --events --png "$out/events.png" --size 1200x900
+  pvbatch tests/render/check_png.py "$out/events.png"'
