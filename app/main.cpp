@@ -63,11 +63,10 @@ rocklab::JsonAt shape_option(const std::string& text, const std::string& option)
   rocklab::JsonAt at{nullptr, option, option.substr(2)};
   if (text.empty())
     return at;
-  try {
-    at.value = nlohmann::json::parse(text);
-  } catch (const std::exception& e) {
-    throw rocklab::InputError(option + ": not JSON: " + std::string(e.what()));
-  }
+  // Read as an input file is: the same depth limit, duplicate-key and null checks, and errors
+  // that name the option (a 60,000-deep array crashed nlohmann's recursive parser).
+  const rocklab::InputText as_file(option, text);
+  at.value = rocklab::read_json_file(option);
   return at;
 }
 

@@ -343,7 +343,7 @@ MaterialCard load_material_card(const std::string& path) {
   c.source = top.string("source", "");
   top.string("description", "");
   c.dim = static_cast<int>(top.integer("dimension", 2, 3));
-  c.density = top.number("density", Range::positive(), std::nullopt, "kg/m^3");
+  c.density = top.number("density", Range::density(), std::nullopt, "kg/m^3");
   c.seed = static_cast<std::uint64_t>(
       top.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), 1));
   read_grains(top, c);

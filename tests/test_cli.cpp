@@ -2,6 +2,7 @@
 #include "helpers.hpp"
 
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <vector>
 
@@ -256,6 +257,31 @@ TEST(Cli, BadCommandLinesExitWithTwoAndSayWhy) {
   EXPECT_NE(msg.find("seed"), std::string::npos) << msg;
   EXPECT_EQ(run_command(binary() + " info --bogus", &msg), 2);
   EXPECT_NE(msg.find("bogus"), std::string::npos) << msg;
+}
+
+TEST(Cli, AShapeOnTheCommandLineIsReadAsAnInputFileIs) {
+  // A 60,000-deep array given to --shape crashed the recursive JSON parser (segmentation
+  // fault); it now meets the input files' depth limit, and malformed JSON names the option.
+  const fs::path deep = rocklab::test::scratch_root() / "deep_shape.json";
+  {
+    std::ofstream f(deep);
+    f << std::string(60000, '[') << std::string(60000, ']');
+  }
+  const std::string card = source_dir() + "/materials/granite_fj_2d.json";
+  const fs::path out = rocklab::test::scratch_root() / "deep_shape.rlspec";
+  std::string msg;
+  EXPECT_EQ(run_command(binary() + " genesis " + card + " -o " + out.string() +
+                            " -q --shape \"$(cat " + deep.string() + ")\"",
+                        &msg),
+            2);
+  EXPECT_NE(msg.find("--shape"), std::string::npos) << msg.substr(0, 300);
+  EXPECT_NE(msg.find("deeper than 256"), std::string::npos) << msg.substr(0, 300);
+  EXPECT_EQ(run_command(binary() + " genesis " + card + " -o " + out.string() +
+                            " -q --cut '{\"shape\": '",
+                        &msg),
+            2);
+  EXPECT_NE(msg.find("--cut"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(Cli, EveryExampleRuns) {

@@ -110,6 +110,40 @@ TEST(Robustness, AnOutputFolderThatIsAFileIsABadCommandLine) {
 // Issue 41: valid but huge inputs started work silently. The run's records that cannot fit in
 // memory are refused before it starts (exit 2 naming the file and the key, nothing written); a
 // run past an hour is announced with a warning.
+TEST(Robustness, KeysAreBoundedToWhatTheModelCanComputeAndSaySo) {
+  // Values that passed an open range and then broke the run: a ball of density 1e308 (NaN
+  // results at exit 0), a flat joint's fj_kratio of 1e308 (genesis cycled without end) and a
+  // strain limit of 1e-320 (stopped at once, reported nothing). Each is an input error now.
+  const fs::path dir = scratch("bounds");
+  fs::create_directories(dir);
+  nlohmann::json scene = read_json_file(test::source_dir() + "/examples/ball_drop.json");
+  scene["balls"][0]["density"] = 1e308;
+  nlohmann::json card = read_json_file(test::source_dir() + "/materials/granite_fj_2d.json");
+  card["flatjoint"]["fj_kratio"] = 1e308;
+  const nlohmann::json protocol = {
+      {"test", "ucs"},
+      {"units", "SI"},
+      {"specimen", {{"material", test::source_dir() + "/materials/granite_fj_2d.json"}}},
+      {"stop", {{"strain_limit", 1e-320}}}};
+  const fs::path scene_file = dir / "scene.json", card_file = dir / "card.json",
+                 protocol_file = dir / "ucs.json";
+  std::ofstream(scene_file) << scene.dump();
+  std::ofstream(card_file) << card.dump();
+  std::ofstream(protocol_file) << protocol.dump();
+  for (const auto& [cmd, key, range] : std::vector<std::array<std::string, 3>>{
+           {" run " + scene_file.string(), "density", "1e+06"},
+           {" genesis " + card_file.string(), "fj_kratio", "1000"},
+           {" test " + protocol_file.string(), "strain_limit", "1e-05"}}) {
+    const fs::path out = dir / "out";
+    std::string msg;
+    EXPECT_EQ(test::run_command(test::binary() + cmd + " -o " + out.string() + " -q", &msg), 2)
+        << cmd << ": " << msg;
+    EXPECT_NE(msg.find(key), std::string::npos) << msg;
+    EXPECT_NE(msg.find(range), std::string::npos) << msg;
+    EXPECT_FALSE(fs::exists(out)) << msg;
+  }
+}
+
 TEST(Robustness, HugeButValidRunsAreRefusedOrWarnedBeforeTheyStart) {
   const fs::path dir = scratch("huge");
   fs::create_directories(dir);

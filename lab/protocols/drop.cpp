@@ -36,7 +36,7 @@ DropProtocol drop_protocol_from_json(const nlohmann::json& j, const std::string&
   p.dim = static_cast<int>(top.integer("dimension", 2, 3, 2));
   {
     JsonObject r = top.object("rock");
-    p.density = r.number("density", Range::positive(), std::nullopt, "kg/m^3");
+    p.density = r.number("density", Range::density(), std::nullopt, "kg/m^3");
     p.rock = read_clump_pebbles(r, p.dim, false);
     if (r.has("bond")) {
       JsonObject b = r.object("bond");

@@ -45,10 +45,12 @@ StiffnessPair read_stiffness_pair(JsonObject& p, const std::string& prefix, cons
                      "/" + kratio + ", not both");
   if (s.deformability) {
     s.emod = p.number(emod, Range::positive(), std::nullopt, "Pa");
-    s.kratio = p.number(kratio, Range::non_negative(), 0.0);
+    // Beyond a ratio of 1000 either way the shear or normal stiffness is numerically nil for
+    // the time step (fj_kratio 1e308 kept genesis cycling without end).
+    s.kratio = p.number(kratio, Range::closed(0, 1e3), 0.0);
     if (s.kratio > 0 && s.kratio < 1e-3)
       p.fail(kratio, "value " + p.raw(kratio).dump() +
-                         " is out of range: 0 (no shear stiffness) or [0.001, +inf)");
+                         " is out of range: 0 (no shear stiffness) or [0.001, 1000]");
   } else {
     s.kn = p.number(kn, Range::non_negative(), kn_required ? std::nullopt : std::optional(0.0),
                     k_unit);

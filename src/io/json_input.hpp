@@ -34,6 +34,9 @@ struct Range {
   static Range at_least(double a) {
     return {a, std::numeric_limits<double>::infinity(), false, true};
   }
+  /// A material density [kg/m^3]: up to 1e6, some 40 times osmium's (the densest element, 22,590);
+  /// beyond that no grain is a rock, and 1e308 overflowed the masses into NaN results.
+  static Range density() { return {0, 1e6, true, false}; }
 };
 
 /// Why `path` cannot be an input file (a directory, a device or a socket), or "".

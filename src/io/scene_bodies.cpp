@@ -155,7 +155,7 @@ void read_clumps(JsonObject& top, Model& m, std::map<std::int64_t, std::string>&
                                       static_cast<std::int64_t>(m.clumps.size()) + 1);
     if (auto [it, fresh] = clump_ids.emplace(id, path); !fresh)
       o.fail("id", std::to_string(id) + " is already used by " + it->second);
-    const double rho = o.number("density", Range::positive(), std::nullopt, "kg/m^3");
+    const double rho = o.number("density", Range::density(), std::nullopt, "kg/m^3");
     const int g = m.group_index(o.string("group", "default"));
     const std::vector<Pebble> pebbles = read_clump_pebbles(o, dim, true);
     const Vec3 vel = o.vec("velocity", dim, Vec3::Zero());
@@ -197,7 +197,7 @@ void generate_balls(JsonObject& o, const std::string& path, Model& m,
   for (int d = 0; d < dim; ++d)
     if (!(hi[d] - lo[d] > 2 * rmax))
       o.fail("box", "the box must be wider than 2 R_max along every axis");
-  const double rho = o.number("density", Range::positive(), std::nullopt, "kg/m^3");
+  const double rho = o.number("density", Range::density(), std::nullopt, "kg/m^3");
   const std::uint64_t seed =
       static_cast<std::uint64_t>(o.integer("seed", 0, std::numeric_limits<std::int64_t>::max(), 1));
   const int g = m.group_index(o.string("group", "default"));
@@ -270,7 +270,7 @@ void read_balls(JsonObject& top, Model& m) {
     claim_id(id, path);
     const Vec3 x = o.vec("position", dim);
     const double r = o.number("radius", Range::positive(), std::nullopt, "m");
-    const double rho = o.number("density", Range::positive(), std::nullopt, "kg/m^3");
+    const double rho = o.number("density", Range::density(), std::nullopt, "kg/m^3");
     const int g = m.group_index(o.string("group", "default"));
     const std::size_t i = m.balls.add(dim, id, x, r, rho, g);
     read_ball_motion(o, m, i);
