@@ -17,15 +17,16 @@ that cannot be written ``OSError`` (status 4). Long calls release the GIL; Ctrl-
 ``KeyboardInterrupt`` and nothing half-written. ``progress`` takes a callable given a
 :class:`Progress` about twice a second.
 """
-import json
-import os
-import shutil
-import tempfile
-from typing import NamedTuple, Optional
+# The standard modules under private names: the package's namespace is its API (dir(rocklab)).
+import json as _json
+import os as _os
+import shutil as _shutil
+import tempfile as _tempfile
+from typing import NamedTuple as _NamedTuple, Optional as _Optional
 
 from . import _rocklab
 from ._rocklab import PhysicsError
-from ._tables import read_structured, read_table
+from ._tables import read_structured as _read_structured, read_table as _read_table
 
 __version__ = _rocklab.VERSION
 __all__ = ["genesis", "test", "suite", "calibrate", "run", "Specimen", "TestResult",
@@ -33,23 +34,23 @@ __all__ = ["genesis", "test", "suite", "calibrate", "run", "Specimen", "TestResu
            "lab_tests", "executable"]
 
 
-class Progress(NamedTuple):
+class Progress(_NamedTuple):
     """One progress report: the command (``tag``: "test", "genesis", "suite", ...), its state as
     ``rocklab`` prints it, the fraction done in [0, 1] (None: unknown), the elapsed time [s] and
     the estimated time left [s] (None: unknown)."""
     tag: str
     message: str
-    fraction: Optional[float]
+    fraction: _Optional[float]
     elapsed_s: float
-    eta_s: Optional[float]
+    eta_s: _Optional[float]
 
 
 def _source(value, kind):
     """(name, text) for the extension: a path as itself, a dict as its JSON under "<KIND dict>"."""
     if isinstance(value, dict):
-        return "<%s dict>" % kind, json.dumps(value)
-    if isinstance(value, (str, os.PathLike)):
-        return os.fspath(value), None
+        return "<%s dict>" % kind, _json.dumps(value)
+    if isinstance(value, (str, _os.PathLike)):
+        return _os.fspath(value), None
     raise TypeError("%s: expected a file path or a dict, got %s" % (kind, type(value).__name__))
 
 
@@ -74,11 +75,11 @@ def executable():
     """The ``rocklab`` binary that suites and calibrations start for their tests: the
     ROCKLAB_EXECUTABLE environment variable when set, else the one built or installed with this
     module."""
-    path = os.environ.get("ROCKLAB_EXECUTABLE")
+    path = _os.environ.get("ROCKLAB_EXECUTABLE")
     if not path:
         from ._config import EXECUTABLE
         path = EXECUTABLE
-    if not os.access(path, os.X_OK):
+    if not _os.access(path, _os.X_OK):
         raise FileNotFoundError("rocklab binary %s not found (build the project, or set "
                                 "ROCKLAB_EXECUTABLE)" % path)
     return path
@@ -94,18 +95,18 @@ class _Output:
 
     def __init__(self, out):
         self.asked = out is not None
-        self.tmp = None if self.asked else tempfile.mkdtemp(prefix="rocklab-")
-        self.path = os.fspath(out) if self.asked else os.path.join(self.tmp, "out")
+        self.tmp = None if self.asked else _tempfile.mkdtemp(prefix="rocklab-")
+        self.path = _os.fspath(out) if self.asked else _os.path.join(self.tmp, "out")
 
     def __enter__(self):
         return self
 
     def __exit__(self, *exc):
         if self.tmp:
-            shutil.rmtree(self.tmp, ignore_errors=True)
+            _shutil.rmtree(self.tmp, ignore_errors=True)
 
     def file(self, name):
-        return os.path.join(self.path, name)
+        return _os.path.join(self.path, name)
 
 
 class Specimen:
@@ -119,24 +120,24 @@ class Specimen:
     def load(path):
         """Read a specimen file written by ``rocklab genesis`` or :meth:`save` (with its
         PATH.report.json when present)."""
-        return Specimen(_rocklab.load_specimen(os.fspath(path)))
+        return Specimen(_rocklab.load_specimen(_os.fspath(path)))
 
     def save(self, path):
         """Write the specimen to ``path`` and its genesis report to ``path + ".report.json"``,
         byte for byte what ``rocklab genesis -o path`` writes (the report's wall time aside)."""
-        self._h.save(os.fspath(path))
+        self._h.save(_os.fspath(path))
 
     @property
     def report(self):
         """The genesis report (grains, contacts, porosity, stresses [Pa], steps, wall time [s]) as
         a dict; None for a file without its report."""
-        return json.loads(self._h.report_json)
+        return _json.loads(self._h.report_json)
 
     @property
     def meta(self):
         """What the specimen file records of its making: rocklab version, the card (file, name,
         hash, JSON), the seed and the genesis report."""
-        return json.loads(self._h.meta_json)
+        return _json.loads(self._h.meta_json)
 
     @property
     def grains(self):
@@ -168,7 +169,7 @@ def genesis(card, seed=None, threads=None, overrides=None, progress=None):
         raise ValueError("seed: %r is not a seed: a whole number in [0, 2^63)" % (seed,))
     if overrides is not None and not isinstance(overrides, dict):
         raise TypeError("overrides: expected a dict of \"section.key\" -> value")
-    handle = _rocklab.genesis(name, text, json.dumps(overrides or {}),
+    handle = _rocklab.genesis(name, text, _json.dumps(overrides or {}),
                               -1 if seed is None else seed, _threads(threads),
                               _callback(progress))
     return Specimen(handle)
@@ -208,20 +209,20 @@ def test(protocol, specimen=None, out=None, threads=None, progress=None):
     read. threads: OpenMP threads (None: every core). Returns a :class:`TestResult`.
     """
     name, text = _source(protocol, "protocol")
-    with _Output(out) as o, tempfile.TemporaryDirectory(prefix="rocklab-") as scratch:
+    with _Output(out) as o, _tempfile.TemporaryDirectory(prefix="rocklab-") as scratch:
         specimen_file = ""
         if isinstance(specimen, Specimen):
-            specimen_file = os.path.join(scratch, "specimen.rlspec")
+            specimen_file = _os.path.join(scratch, "specimen.rlspec")
             specimen.save(specimen_file)
         elif specimen is not None:
-            specimen_file = os.path.abspath(os.fspath(specimen))
+            specimen_file = _os.path.abspath(_os.fspath(specimen))
         results = _rocklab.test(name, text, specimen_file, o.path, _threads(threads),
                                 _callback(progress))
         if not results:
             raise KeyboardInterrupt("rocklab test interrupted; nothing was written")
-        return TestResult(json.loads(results), read_structured(o.file("history.csv")),
-                          read_structured(o.file("cracks.csv")),
-                          read_structured(o.file("events.csv")), o.path if o.asked else None)
+        return TestResult(_json.loads(results), _read_structured(o.file("history.csv")),
+                          _read_structured(o.file("cracks.csv")),
+                          _read_structured(o.file("events.csv")), o.path if o.asked else None)
 
 
 class SuiteResult:
@@ -246,9 +247,9 @@ def suite(suite, out=None, threads=None, progress=None):
     Returns a :class:`SuiteResult`."""
     name, text = _source(suite, "suite")
     with _Output(out) as o:
-        results = json.loads(_rocklab.suite(name, text, o.path, _threads(threads), executable(),
+        results = _json.loads(_rocklab.suite(name, text, o.path, _threads(threads), executable(),
                                             _callback(progress)))
-        return SuiteResult(read_table(o.file("summary.csv")), read_table(o.file("tests.csv")),
+        return SuiteResult(_read_table(o.file("summary.csv")), _read_table(o.file("tests.csv")),
                            results, o.path if o.asked else None)
 
 
@@ -271,12 +272,12 @@ def calibrate(calibration, out, jobs=None, progress=None):
     reuses). jobs: test processes at once (None: one per core). Returns a
     :class:`CalibrationResult`."""
     name, text = _source(calibration, "calibration")
-    out = os.fspath(out)
-    summary = json.loads(_rocklab.calibrate(name, text, out, _threads(jobs), executable(),
+    out = _os.fspath(out)
+    summary = _json.loads(_rocklab.calibrate(name, text, out, _threads(jobs), executable(),
                                             _callback(progress)))
-    with open(os.path.join(out, "card.json"), encoding="utf-8") as f:
-        card = json.load(f)
-    with open(os.path.join(out, "report.md"), encoding="utf-8") as f:
+    with open(_os.path.join(out, "card.json"), encoding="utf-8") as f:
+        card = _json.load(f)
+    with open(_os.path.join(out, "report.md"), encoding="utf-8") as f:
         report = f.read()
     return CalibrationResult(summary, card, report, out)
 
@@ -296,9 +297,9 @@ def run(scene, out=None, threads=None, progress=None):
     core). Returns a :class:`RunResult`."""
     name, text = _source(scene, "scene")
     with _Output(out) as o:
-        summary = json.loads(_rocklab.run(name, text, o.path, _threads(threads),
+        summary = _json.loads(_rocklab.run(name, text, o.path, _threads(threads),
                                           _callback(progress)))
         with open(o.file("results.json"), encoding="utf-8") as f:
-            results = json.load(f)
-        return RunResult(summary, results, read_structured(o.file("history.csv")),
+            results = _json.load(f)
+        return RunResult(summary, results, _read_structured(o.file("history.csv")),
                          o.path if o.asked else None)

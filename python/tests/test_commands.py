@@ -62,3 +62,9 @@ def test_calibrate_writes_its_card_and_report(tmp_path):
     assert "youngs_modulus_Pa" in r.report or "Young" in r.report
     assert r.summary["evaluations"] >= 1
     assert os.path.exists(tmp_path / "cal" / "card.json")
+
+
+def test_the_package_namespace_is_its_api():
+    # dir(rocklab) lists what the package offers, not the modules it uses (json, os, typing...).
+    public = {n for n in dir(rocklab) if not n.startswith("_")}
+    assert public == set(rocklab.__all__)
