@@ -38,12 +38,14 @@ void read_common_loading(JsonObject& l, Protocol& p) {
 void read_common_stop(JsonObject& s, Protocol& p) {
   p.post_peak_fraction = s.number("post_peak_fraction", {0, 1, true, true}, 0.9);
   p.min_steps = s.integer("min_steps", 0, std::numeric_limits<std::int64_t>::max(), 1000);
-  // 0: none. A limit below 1e-5 ends the test before any rock's elastic window (1e-4 to 1e-3) is
-  // read (1e-320 ran and reported nothing); above 1 the specimen is gone.
+  // 0: none. Below 1e-12 a strain is lost in the rounding of the grains' positions (1e-320 ran
+  // and reported nothing); above 1 the specimen is gone. (A limit before the elastic window, e.g.
+  // 1e-6, is computable: the test reports its E as not measured.)
   p.strain_limit = s.number("strain_limit", Range::closed(0, 1), 0.0);
-  if (p.strain_limit > 0 && p.strain_limit < 1e-5)
+  if (p.strain_limit > 0 && p.strain_limit < 1e-12)
     s.fail("strain_limit", "value " + s.raw("strain_limit").dump() +
-                               " is out of range: 0 (no limit) or [1e-05, 1]");
+                               " is out of range: 0 (no limit) or [1e-12, 1] (a smaller strain is "
+                               "lost in the rounding of the grains' positions)");
   p.max_steps = s.integer("max_steps", 1, std::numeric_limits<std::int64_t>::max(), 5'000'000);
 }
 

@@ -7,6 +7,7 @@
 #include "lab/protocol_table.hpp"
 #include "lab/protocols/frame_protocol.hpp"
 #include "lab/suite_jobs.hpp"
+#include "materials/genesis.hpp"
 #include "materials/material_card.hpp"
 
 #include <algorithm>
@@ -308,9 +309,29 @@ std::vector<std::string> summary_columns() {
   return cols;
 }
 
+void say_genesis_estimates(const std::string& card_file, const std::string& file,
+                           const std::vector<TestShape>& tests, const char* tag, bool print) {
+  const MaterialCard card = load_material_card(card_file);
+  std::set<std::string> seen; // one line per distinct specimen
+  for (std::size_t k = 0; k < tests.size(); ++k) {
+    const TestShape& t = tests[k];
+    if (!seen.insert(t.shape.dump() + t.cut.dump()).second)
+      continue;
+    const std::string at = "tests[" + std::to_string(k) + "]";
+    const std::string line = genesis_estimate(
+        card, {{t.shape, file, at + ".shape"}, {t.cut, file, at + ".cut"}, std::nullopt});
+    if (print && !line.empty())
+      std::fprintf(stderr, "[rocklab %s] %s: genesis %s\n", tag, t.name.c_str(), line.c_str());
+  }
+}
+
 nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
   using clock = std::chrono::steady_clock;
   const auto t0 = clock::now();
+  std::vector<TestShape> shapes;
+  for (const SuiteTest& t : s.tests)
+    shapes.push_back({t.name, t.shape, t.cut});
+  say_genesis_estimates(s.material_file, s.file, shapes, "suite", o.progress);
   OutputDir out(o.out_dir);
   SuiteRun run(s, o, out);
   run.cores = std::max(1u, std::thread::hardware_concurrency());

@@ -45,6 +45,19 @@ struct SuiteOptions {
   const std::atomic<bool>* interrupt = nullptr;
 };
 
+/// A test's specimen shape and cut as given (null: the card's).
+struct TestShape {
+  std::string name;
+  nlohmann::json shape, cut;
+};
+
+/// Each distinct specimen's genesis estimate (grains, memory, time on one core), printed as
+/// "[rocklab TAG] NAME: genesis estimate: ..." when `print`, before any work starts: a specimen far
+/// larger than meant (a width of 12 for 0.012 m) shows itself at once, and one that cannot fit is
+/// refused (InputError naming `file` and the test's tests[k].shape).
+void say_genesis_estimates(const std::string& card_file, const std::string& file,
+                           const std::vector<TestShape>& tests, const char* tag, bool print);
+
 /// Run the suite; writes OUTDIR/summary.json, summary.csv, tests.csv, specimens/, tests/NAME/.
 /// Returns the summary. Nothing is left in OUTDIR when it fails or is interrupted.
 nlohmann::json run_suite(const Suite& s, const SuiteOptions& o);

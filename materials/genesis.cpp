@@ -89,6 +89,25 @@ nlohmann::json specimen_meta(const MaterialCard& card, const GenesisReport& repo
           {"report", r}};
 }
 
+namespace {
+
+std::string estimate_line(const genesis::GenesisEstimate& est) {
+  if (!(est.grains > 0))
+    return "";
+  std::ostringstream msg;
+  msg << std::setprecision(3) << "estimate: about " << est.grains << " grains, "
+      << (est.bytes < 1e9 ? est.bytes / 1e6 : est.bytes / 1e9) << (est.bytes < 1e9 ? " MB" : " GB")
+      << ", " << ProgressLine::duration(est.seconds) << " on one core";
+  return msg.str();
+}
+
+} // namespace
+
+std::string genesis_estimate(MaterialCard card, const GenesisOverrides& o) {
+  apply_overrides(card, o);
+  return estimate_line(genesis::estimate_genesis(card));
+}
+
 GenesisResult run_genesis(const MaterialCard& card,
                           const std::function<void(const std::string&)>& progress,
                           const std::atomic<bool>* interrupt) {
@@ -101,14 +120,10 @@ GenesisResult run_genesis(const MaterialCard& card,
   m.settings.local_damping = 0.7;
   m.settings.gravity = Vec3::Zero();
   m.settings.slip_events = false; // nobody reads them during genesis
-  const genesis::GenesisEstimate est = genesis::estimate_genesis(card);
+  const std::string estimate = estimate_line(genesis::estimate_genesis(card));
   genesis::Run run(card, m, rep, progress, interrupt);
-  if (est.grains > 0) {
-    std::ostringstream msg;
-    msg << std::setprecision(3) << "estimate: about " << est.grains << " grains, "
-        << est.bytes / 1e6 << " MB, " << est.seconds << " s on one core";
-    run.say(msg.str());
-  }
+  if (!estimate.empty())
+    run.say(estimate);
   if (card.packing_import.empty()) {
     genesis::place_grains(run);
     const genesis::PackingKey key = genesis::packing_key(run);
@@ -145,8 +160,13 @@ GenesisResult genesis_with_overrides(MaterialCard& card, const GenesisOverrides&
   GenesisResult g = run_genesis(
       card,
       [&](const std::string& phase) {
-        if (line.due())
+        // The estimate is shown at once, on a line of its own: a specimen far larger than meant
+        // (a width of 12 for 0.012 m) says so before it runs for minutes without a line.
+        const bool estimate = phase.rfind("estimate:", 0) == 0;
+        if (estimate || line.due())
           line.show(phase);
+        if (estimate)
+          line.finish();
       },
       interrupt);
   line.finish();

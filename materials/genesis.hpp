@@ -50,6 +50,12 @@ GenesisResult run_genesis(const MaterialCard& card,
                           const std::function<void(const std::string&)>& progress = {},
                           const std::atomic<bool>* interrupt = nullptr);
 
+/// What genesis of `card` with `o` applied will take, as its progress line says it: "estimate:
+/// about N grains, M MB, T on one core" ("" for an imported packing). Throws InputError naming
+/// the key for a card that cannot finish (genesis/estimate.cpp), so a caller can refuse it
+/// before any work starts.
+std::string genesis_estimate(MaterialCard card, const GenesisOverrides& o);
+
 /// The one path from a card to a specimen, for `rocklab genesis` and a protocol's
 /// `specimen.material`: the overrides applied to the card (a bad shape fails naming where it was
 /// given), then genesis with a "genesis" progress line on stderr when `progress`.

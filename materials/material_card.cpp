@@ -136,8 +136,10 @@ ShapeSpec shape_from_json(const nlohmann::json& j, int dim, const std::string& f
 }
 
 void apply_overrides(MaterialCard& card, const GenesisOverrides& o) {
-  if (!o.shape.value.is_null())
+  if (!o.shape.value.is_null()) {
     card.vessel = shape_from_json(o.shape.value, card.dim, o.shape.file, o.shape.key);
+    card.vessel_file = o.shape.file, card.vessel_key = o.shape.key;
+  }
   if (!o.cut.value.is_null())
     card.cut = shape_from_json(o.cut.value, card.dim, o.cut.file, o.cut.key, true);
   if (o.seed)

@@ -55,8 +55,9 @@ struct MaterialCard {
   std::vector<std::pair<double, double>>
       sieve; ///< (diameter [m], mass fraction passing), ascending
   double porosity = 0.36;
-  ShapeSpec vessel;             ///< the packed block
-  std::optional<ShapeSpec> cut; ///< test shape cut from the block
+  ShapeSpec vessel;                                 ///< the packed block
+  std::string vessel_file, vessel_key = "specimen"; ///< where it was given ("": the card's file)
+  std::optional<ShapeSpec> cut;                     ///< test shape cut from the block
   std::uint64_t seed = 1;
   // packing
   enum class Packing { Contraction, Scaling } packing_method = Packing::Contraction;

@@ -509,7 +509,7 @@ nlohmann::json tiny_calibration(const std::string& name, const std::vector<int>&
 TEST(CalibrationCli, ATestThatRejectsItsInputStopsTheCampaignWithTwo) {
   // A Brazilian disk whose round vessel missed the card's porosity on one seed used to leave BTS
   // unmeasured in every evaluation while the optimiser went on. Here the UCS specimen is too small
-  // for the grains: the campaign stops at once, exit 2, naming the test, the seed and the cause.
+  // for the grains: the campaign stops at once, exit 2, naming where the shape was given and why.
   namespace fs = std::filesystem;
   const fs::path dir = rocklab::test::scratch_root() / "calibrate-bad-test";
   fs::remove_all(dir);
@@ -524,9 +524,10 @@ TEST(CalibrationCli, ATestThatRejectsItsInputStopsTheCampaignWithTwo) {
                                        &msg),
             2)
       << msg;
-  EXPECT_NE(msg.find("test 'ucs' of seed 1"), std::string::npos) << msg;
-  // Refused before genesis starts (the estimate), no longer after packing missed the porosity.
-  EXPECT_NE(msg.find("key 'specimen': its smallest dimension"), std::string::npos) << msg;
+  // Refused before any process starts (the estimate of each test's specimen), naming the key
+  // where the shape was given, no longer after a seed's packing missed the porosity.
+  EXPECT_NE(msg.find(file + ": key 'tests[0].shape': its smallest dimension"), std::string::npos)
+      << msg;
   EXPECT_FALSE(fs::exists(dir / "out" / "card.json"));
 }
 

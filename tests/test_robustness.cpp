@@ -133,7 +133,7 @@ TEST(Robustness, KeysAreBoundedToWhatTheModelCanComputeAndSaySo) {
   for (const auto& [cmd, key, range] : std::vector<std::array<std::string, 3>>{
            {" run " + scene_file.string(), "density", "1e+06"},
            {" genesis " + card_file.string(), "fj_kratio", "1000"},
-           {" test " + protocol_file.string(), "strain_limit", "1e-05"}}) {
+           {" test " + protocol_file.string(), "strain_limit", "1e-12"}}) {
     const fs::path out = dir / "out";
     std::string msg;
     EXPECT_EQ(test::run_command(test::binary() + cmd + " -o " + out.string() + " -q", &msg), 2)
@@ -142,6 +142,57 @@ TEST(Robustness, KeysAreBoundedToWhatTheModelCanComputeAndSaySo) {
     EXPECT_NE(msg.find(range), std::string::npos) << msg;
     EXPECT_FALSE(fs::exists(out)) << msg;
   }
+}
+
+TEST(Robustness, AUnitSlipSpecimenShowsItsEstimateAtOnceAndIsRefusedWhereItCannotFit) {
+  // The 2D granite card's UCS with the specimen given in the wrong unit: 0.3 x 0.6 (m, meant as
+  // 30 x 60 mm: about 160,000 grains) runs for hours, so its estimate is the first line, within
+  // a second; 12 x 24 (meant as mm) cannot fit and is refused before any work, by `test` and by
+  // `suite` alike.
+  const fs::path dir = scratch("unit_slip");
+  fs::create_directories(dir);
+  const std::string card = test::source_dir() + "/materials/granite_fj_2d.json";
+  auto protocol = [&](double w, double h) {
+    const fs::path f = dir / ("ucs_" + std::to_string(w) + ".json");
+    std::ofstream(f) << nlohmann::json{{"test", "ucs"},
+                                       {"units", "SI"},
+                                       {"specimen",
+                                        {{"material", card},
+                                         {"shape",
+                                          {{"shape", "rectangle"}, {"width", w}, {"height", h}}}}}}
+                            .dump();
+    return f.string();
+  };
+  std::string msg;
+  // Killed after a second: what it printed by then (stderr is unbuffered) holds the estimate.
+  test::run_command("timeout -s KILL 1 " + test::binary() + " test " + protocol(0.3, 0.6) + " -o " +
+                        (dir / "killed").string(),
+                    &msg);
+  EXPECT_NE(msg.find("estimate: about 1.6"), std::string::npos) << msg; // 1.6e+05 grains
+  EXPECT_NE(msg.find("on one core"), std::string::npos) << msg;
+  EXPECT_EQ(test::run_command(test::binary() + " test " + protocol(12, 24) + " -o " +
+                                  (dir / "out").string(),
+                              &msg),
+            2);
+  EXPECT_NE(msg.find(protocol(12, 24) + ": key 'specimen.shape'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("GB"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+  const fs::path suite = dir / "suite.json";
+  std::ofstream(suite)
+      << nlohmann::json{{"name", "slip"},
+                        {"units", "SI"},
+                        {"material", card},
+                        {"tests",
+                         {{{"name", "ucs"},
+                           {"test", "ucs"},
+                           {"shape", {{"shape", "rectangle"}, {"width", 12}, {"height", 24}}}}}}}
+             .dump();
+  EXPECT_EQ(test::run_command(test::binary() + " suite " + suite.string() + " -o " +
+                                  (dir / "suite_out").string(),
+                              &msg),
+            2);
+  EXPECT_NE(msg.find(suite.string() + ": key 'tests[0].shape'"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(dir / "suite_out"));
 }
 
 TEST(Robustness, HugeButValidRunsAreRefusedOrWarnedBeforeTheyStart) {

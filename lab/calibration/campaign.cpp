@@ -1,5 +1,7 @@
 #include "lab/calibration/campaign.hpp"
 
+#include "lab/suite.hpp"
+
 #include "io/output_dir.hpp"
 #include "lab/calibration/noise.hpp"
 #include "lab/calibration/report.hpp"
@@ -135,6 +137,11 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   Evaluation last;
   int count = 0;
   const bool talk = o.progress && (!o.ranks || o.ranks->root());
+  std::vector<TestShape> shapes;
+  for (const auto& t : c.tests)
+    shapes.push_back({t.value("name", std::string()), t.value("shape", nlohmann::json()),
+                      t.value("cut", nlohmann::json())});
+  say_genesis_estimates(c.material_file, c.file, shapes, "calibrate", talk); // per seed
   const Evaluate evaluate = [&](const std::vector<double>& v, Stage s) {
     const auto t = std::chrono::steady_clock::now();
     last = ev.run(v, s);

@@ -21,12 +21,15 @@ namespace {
 // granite_fj_3d (1,670 grains, 41.2 MB: 14.8 kB each) [bytes].
 constexpr double kBytesPerGrain2D = 12e3;
 constexpr double kBytesPerGrain3D = 30e3;
-// Work per grain and cycle on one core measured on the same two runs (4,533 grains x 286,500
-// cycles in 410 s; 1,670 x 134,000 in 240 s), and the cycles a preset's genesis takes — for the
-// printed estimate only.
-constexpr double kSecondsPerGrainCycle2D = 0.32e-6;
-constexpr double kSecondsPerGrainCycle3D = 1.1e-6;
-constexpr double kTypicalCycles = 2e5;
+// Work per grain and cycle on one core and the cycles a preset's genesis takes, for the printed
+// estimate only, measured on the quiet 2-core machine (2026-12-07): granite_fj_2d, 1,126 grains,
+// 156,600 cycles in 28.4 s; granite_fj_3d (the main job's cylinder), 1,643 grains, about 111,000
+// cycles in about 100 s (the earlier figures, 0.32 and 1.1 us at 2e5 cycles, were 2.6 and 3.7
+// times the time genesis takes now).
+constexpr double kSecondsPerGrainCycle2D = 0.16e-6;
+constexpr double kSecondsPerGrainCycle3D = 0.55e-6;
+constexpr double kTypicalCycles2D = 1.6e5;
+constexpr double kTypicalCycles3D = 1.1e5;
 // Ball indices are 32-bit (contact adjacency stores index*2 + side).
 constexpr double kMaxGrains = 1e8;
 // The installation pressure over the grains' modulus below which the overlap it causes (this
@@ -71,8 +74,12 @@ double grains_in(const MaterialCard& c, double solid) {
   return n;
 }
 
+// The specimen's shape may come from a protocol, a suite, a calibration or the command line: the
+// error names where it was given.
 [[noreturn]] void refuse(const MaterialCard& c, const std::string& key, const std::string& what) {
-  throw InputError(c.file + ": key '" + key + "': " + what);
+  const bool vessel = key == "specimen" && !c.vessel_file.empty();
+  throw InputError((vessel ? c.vessel_file : c.file) + ": key '" + (vessel ? c.vessel_key : key) +
+                   "': " + what);
 }
 
 void check_shape(const MaterialCard& c, const ShapeSpec& s, const std::string& key) {
@@ -102,14 +109,14 @@ GenesisEstimate estimate_genesis(const MaterialCard& c) {
                "R_avg (gap_ratio <= 1)");
   e.grains = grains_in(c, c.vessel.volume(c.dim) * (1 - c.porosity));
   e.bytes = e.grains * (c.dim == 2 ? kBytesPerGrain2D : kBytesPerGrain3D);
-  e.seconds =
-      e.grains * kTypicalCycles * (c.dim == 2 ? kSecondsPerGrainCycle2D : kSecondsPerGrainCycle3D);
+  e.seconds = e.grains * (c.dim == 2 ? kTypicalCycles2D * kSecondsPerGrainCycle2D
+                                     : kTypicalCycles3D * kSecondsPerGrainCycle3D);
   const double ram = physical_memory();
   if (e.grains > kMaxGrains || (ram > 0 && e.bytes > 0.8 * ram))
     refuse(c, "specimen",
            "the specimen holds about " + num(e.grains) + " grains of radius " + num(c.r_min) + "-" +
                num(c.r_max) + " m, needing about " + num(e.bytes / 1e9) + " GB; allowed: at most " +
-               num(kMaxGrains) + " grains within 80 % of this " + "machine's " + num(ram / 1e9) +
+               num(kMaxGrains) + " grains within 80 % of this machine's " + num(ram / 1e9) +
                " GB (a smaller specimen or larger grains)");
   // The installation pressure over the grains' modulus (2D: per unit thickness).
   const double area = linear::deformability_area(c.dim, r_avg);
