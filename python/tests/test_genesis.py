@@ -82,3 +82,22 @@ def test_bad_input_raises_value_error_with_the_command_lines_message(tmp_path):
     with pytest.raises(TypeError):
         rocklab.genesis(42)
     assert not os.path.exists(tmp_path / "x.rlspec")
+
+
+def test_the_first_progress_event_is_the_estimate():
+    # A specimen far larger than meant shows itself before genesis starts: the first event the
+    # callback gets is the estimate (grains, memory, time on one core); raising there stops it.
+    class Seen(Exception):
+        pass
+
+    first = []
+
+    def stop(p):
+        first.append(p)
+        raise Seen()
+
+    with pytest.raises(Seen):
+        rocklab.genesis(CARD, progress=stop)
+    assert first[0].tag == "genesis"
+    assert first[0].message.startswith("estimate: about ")
+    assert first[0].message.endswith(" on one core")
