@@ -89,8 +89,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
   p.file = file;
   p.raw = j;
   JsonObject top(j, file, key_path);
-  if (top.has("units") && top.string("units") != "SI")
-    top.fail("units", "only \"SI\" is supported");
+  read_units(top);
   p.name = top.string("name", "");
   top.string("description", "");
   p.test = top.choice("test", frame_test_names());

@@ -46,8 +46,7 @@ Suite load_suite(const std::string& path) {
   const nlohmann::json j = read_json_file(path);
   s.text_hash = text_hash(read_input_text(path));
   JsonObject top(j, path, "");
-  if (top.has("units") && top.string("units") != "SI")
-    top.fail("units", "only \"SI\" is supported");
+  read_units(top);
   s.name = top.string("name", fs::path(path).stem().string());
   top.string("description", "");
   {

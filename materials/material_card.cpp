@@ -339,8 +339,7 @@ MaterialCard load_material_card(const std::string& path) {
   c.text_hash = text_hash(read_input_text(path));
   c.raw = read_json_file(path);
   JsonObject top(c.raw, path, "");
-  if (top.has("units") && top.string("units") != "SI")
-    top.fail("units", "only \"SI\" is supported");
+  read_units(top);
   c.name = top.string("name");
   c.source = top.string("source", "");
   top.string("description", "");

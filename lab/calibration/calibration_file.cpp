@@ -215,8 +215,7 @@ CalibrationFile load_calibration(const std::string& path) {
   std::string material_from;
   const nlohmann::json j = read_extended(path, material_from);
   JsonObject top(j, path, "");
-  if (top.has("units") && top.string("units") != "SI")
-    top.fail("units", "only \"SI\" is supported");
+  read_units(top);
   c.name = top.string("name", fs::path(path).stem().string());
   top.string("description", "");
   top.string("source", "");

@@ -37,6 +37,11 @@ std::string Range::str() const {
   return s;
 }
 
+void read_units(JsonObject& top) {
+  if (top.has("units") && top.string("units") != "SI")
+    top.fail("units", "only \"SI\" is supported (m, kg, s, N, Pa)");
+}
+
 std::string describe(const nlohmann::json& v) {
   std::string s = v.dump();
   if (s.size() > 60)

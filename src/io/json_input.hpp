@@ -39,6 +39,11 @@ struct Range {
   static Range density() { return {0, 1e6, true, false}; }
 };
 
+class JsonObject;
+/// The header key every input file may give, read in one place: `units`, which must be "SI" (m, kg,
+/// s, N, Pa) when given.
+void read_units(JsonObject& top);
+
 /// Why `path` cannot be an input file (a directory, a device or a socket), or "".
 std::string not_an_input_file(const std::string& path);
 /// The bytes of an input file; a directory, a device or an unreadable file is an input error.

@@ -198,8 +198,7 @@ Scene load_scene(const std::string& path) {
   JsonObject top(j, path, "");
   s.model = std::make_unique<Model>();
   Model& m = *s.model;
-  if (top.has("units") && top.string("units") != "SI")
-    top.fail("units", "only \"SI\" is supported (m, kg, s, N, Pa)");
+  read_units(top);
   s.description = top.string("description", "");
   m.settings.dim = static_cast<int>(top.integer("dimension", 2, 3));
   const int dim = m.settings.dim;
