@@ -133,16 +133,19 @@ void AeMonitor::assign(const Model& m, const Crack& c) {
     }
 }
 
-void AeMonitor::follow(int dim, double time) {
+void AeMonitor::follow(double time) {
   for (Open& o : open_) {
     const Vec3 centroid = o.crack_sum / std::max(o.cracks, 1);
     const Mat3 mt = (o.a - o.a0) - (o.f - o.f0) * centroid.transpose(); // sum dF_i (x - c)_j
     const Mat3 sym = 0.5 * (mt + mt.transpose());
-    const SourceReading r = read_source(sym, dim);
+    // M0 = (sum of squared eigenvalues / 2)^(1/2), and for a symmetric tensor the sum of its
+    // squared eigenvalues is its squared Frobenius norm: no eigen-solve per step (the reading
+    // is made once, of the kept tensor). In 2D the tensor's z row and column are zero.
+    const double m0 = sym.norm() / std::sqrt(2.0);
     AeSource& s = sources_[static_cast<std::size_t>(o.event)];
     s.grains = static_cast<int>(o.grains.size());
-    if (r.m0 > s.m0) {
-      s.m0 = r.m0;
+    if (m0 > s.m0) {
+      s.m0 = m0;
       s.tensor = sym;
       s.time_of_max = time;
     }
@@ -199,7 +202,7 @@ void AeMonitor::step(const Model& m, const std::vector<Crack>& cracks, double vo
       }
   }
   if (tensors_)
-    follow(m.settings.dim, m.time());
+    follow(m.time());
   close_ended(m.time());
 }
 

@@ -65,7 +65,7 @@ private:
   void sum_forces(const Model& m);
   void build_partners(const Model& m);
   void assign(const Model& m, const Crack& c);
-  void follow(int dim, double time);
+  void follow(double time);
   void close_ended(double time);
   double duration(const Model& m, std::int32_t g1, std::int32_t g2) const;
 

@@ -91,15 +91,9 @@ std::string magnitude_frequency_svg(const std::vector<FractureEvent>& events,
     return "";
   std::sort(mw.begin(), mw.end());
   PlotSeries cum{"events with Mw >= m", {}, {}, "#1f77b4"};
-  for (std::size_t i = 0; i < mw.size(); ++i) // N(M >= m) at each magnitude, largest first
-    if (i + 1 == mw.size() || mw[i + 1] != mw[i]) {
-      cum.x.push_back(mw[i]);
-      cum.y.push_back(static_cast<double>(mw.size() - i));
-    }
-  // N(M >= m) is read at the lowest of equal magnitudes: count from the first of them.
-  for (std::size_t k = 0; k < cum.x.size(); ++k) {
-    const auto first = std::lower_bound(mw.begin(), mw.end(), cum.x[k]);
-    cum.y[k] = static_cast<double>(mw.end() - first);
+  for (auto it = mw.begin(); it != mw.end(); it = std::upper_bound(it, mw.end(), *it)) {
+    cum.x.push_back(*it); // N(M >= m) at each distinct magnitude, counted from its first
+    cum.y.push_back(static_cast<double>(mw.end() - it));
   }
   std::map<long, int> bins;
   for (const double m : mw)
@@ -111,7 +105,6 @@ std::string magnitude_frequency_svg(const std::vector<FractureEvent>& events,
   }
   std::vector<PlotSeries> series = {cum, per_bin};
   const BValue b = b_value(mw);
-  std::vector<PlotMarker> markers;
   if (std::isfinite(b.b)) {
     PlotSeries fit{"", {}, {}, "#d62728", true};
     char label[96];
@@ -124,8 +117,8 @@ std::string magnitude_frequency_svg(const std::vector<FractureEvent>& events,
     }
     series.push_back(fit);
   }
-  return line_plot_svg(title, "moment magnitude Mw [-]", "number of events [-]", "", series,
-                       markers, NAN, true);
+  return line_plot_svg(title, "moment magnitude Mw [-]", "number of events [-]", "", series, {},
+                       NAN, true);
 }
 
 std::string acoustic_emission_svg(const LoadCurve& c, const std::vector<FractureEvent>& events,

@@ -55,6 +55,17 @@ def done_rows(path):
         return {(r["preset"], r["test"], r["seed"], r["setting"]): r for r in csv.DictReader(f)}
 
 
+def append_row(path, columns, row, extras="raise"):
+    """One finished row appended to a rows CSV (its header first when the file is new); keys
+    outside `columns` raise, or with extras="ignore" are left out."""
+    new = not os.path.exists(path)
+    with open(path, "a", newline="") as f:
+        w = csv.DictWriter(f, columns, extrasaction=extras)
+        if new:
+            w.writeheader()
+        w.writerow(row)
+
+
 def run(cmd, log):
     with open(log, "w") as out:
         return subprocess.call(cmd, stdout=out, stderr=subprocess.STDOUT)
@@ -150,12 +161,7 @@ def cmd_run(args):
                     row = one_row(args, preset, test, seed, setting, spec) if spec else {
                         "preset": preset, "test": test["name"], "seed": seed,
                         "setting": setting, "stop_reason": "genesis failed"}
-                    new = not os.path.exists(rows_path)
-                    with open(rows_path, "a", newline="") as f:
-                        w = csv.DictWriter(f, COLUMNS)
-                        if new:
-                            w.writeheader()
-                        w.writerow(row)
+                    append_row(rows_path, COLUMNS, row)
                     print("%s %s seed %d %s: %s (%s s)" % (preset, test["name"], seed, setting,
                                                            row.get("strength_Pa", "-"),
                                                            row.get("wall_s")), flush=True)

@@ -97,12 +97,7 @@ def cmd_run(args):
                     row.update({k: r.get(k, "") for k in COLUMNS if k in r})
                     row.update(crack_initiation(args.out, args.preset, test["name"], seed, name))
                 row["card_changes"] = " ".join("%s=%g" % c for c in changes)
-                new = not os.path.exists(rows_path)
-                with open(rows_path, "a", newline="") as f:
-                    w = csv.DictWriter(f, COLUMNS, extrasaction="ignore")
-                    if new:
-                        w.writeheader()
-                    w.writerow(row)
+                ps.append_row(rows_path, COLUMNS, row, extras="ignore")
                 print("%s %s seed %d: %s (%s s)" % (name, test["name"], seed,
                                                    row.get("strength_Pa", "-"), row.get("wall_s")),
                       flush=True)
