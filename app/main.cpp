@@ -93,13 +93,11 @@ int genesis_command(const std::string& material_file, const std::string& out, bo
                 "(packing friction %.3g)\n",
                 r.porosity_target, r.porosity_packed, r.porosity_installed, r.porosity,
                 r.packing_friction);
-    std::printf(
-        "bonds        flat joints: %lld bonded, %lld gapped, %lld slit; parallel bonds %lld; "
-        "contact bonds %lld; linear %lld; smooth joints %lld\n",
-        static_cast<long long>(r.fj_bonded), static_cast<long long>(r.fj_gapped),
-        static_cast<long long>(r.fj_slit), static_cast<long long>(r.pb_bonded),
-        static_cast<long long>(r.cb_bonded), static_cast<long long>(r.linear),
-        static_cast<long long>(r.smoothjoint));
+    std::printf("bonds       ");
+    for (const auto& [what, n] : r.bonds) // the card's bonded model: "flatjoint_slit 9678"
+      std::printf(" %s %lld;", what.c_str(), static_cast<long long>(n));
+    std::printf(" linear %lld; smooth joints %lld\n", static_cast<long long>(r.linear),
+                static_cast<long long>(r.smoothjoint));
     std::printf("stress [Pa]  requested %.4g;", r.pressure);
     for (const auto& [name, s] : r.wall_stress)
       std::printf(" %s %.4g", name.c_str(), s);

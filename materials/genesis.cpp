@@ -42,6 +42,21 @@ double grain_volume_sum(const Model& m) {
 
 } // namespace genesis
 
+nlohmann::json GenesisReport::contact_counts() const {
+  nlohmann::json c = {
+      {"total", contacts}, {"clumps", clumps}, {"linear", linear}, {"smoothjoint", smoothjoint}};
+  // Every bonded model's counts, zero where none was made (a report lists the same keys whatever
+  // the card's model).
+  for_each_model([&]<class M>() {
+    if constexpr (BondsCards<M>)
+      for (const std::string_view what : M::card_counts) {
+        const std::string key = std::string(M::name) + "_" + std::string(what);
+        c[key] = bonded(key);
+      }
+  });
+  return c;
+}
+
 nlohmann::json GenesisReport::to_json() const {
   nlohmann::json walls = nlohmann::json::object();
   for (const auto& [name, s] : wall_stress)
@@ -57,16 +72,7 @@ nlohmann::json GenesisReport::to_json() const {
           {"porosity", porosity},
           {"packing_friction", packing_friction},
           {"coordination_number", coordination},
-          {"contacts",
-           {{"total", contacts},
-            {"flatjoint_bonded", fj_bonded},
-            {"flatjoint_gapped", fj_gapped},
-            {"flatjoint_slit", fj_slit},
-            {"linearpbond_bonded", pb_bonded},
-            {"contactbond_bonded", cb_bonded},
-            {"clumps", clumps},
-            {"linear", linear},
-            {"smoothjoint", smoothjoint}}},
+          {"contacts", contact_counts()},
           {"installation_pressure_Pa", pressure},
           {"wall_stress_Pa", walls},
           {"residual_mean_stress_Pa", residual_mean_stress},

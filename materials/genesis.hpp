@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -16,8 +17,14 @@ struct GenesisReport {
   int dim = 3;
   std::int64_t grains = 0, floaters = 0;
   std::int64_t escaped = 0; ///< grains removed because their centre left the vessel
-  std::int64_t contacts = 0, fj_bonded = 0, fj_gapped = 0, fj_slit = 0, pb_bonded = 0,
-               cb_bonded = 0, clumps = 0, linear = 0, smoothjoint = 0;
+  std::int64_t contacts = 0, clumps = 0, linear = 0, smoothjoint = 0;
+  /// Bond candidates by what they became: "<model>_<count>" (e.g. "flatjoint_slit", the card's
+  /// bonded model's card_counts); bonds(key) reads 0 for one never made.
+  std::map<std::string, std::int64_t> bonds;
+  std::int64_t bonded(const std::string& key) const {
+    const auto it = bonds.find(key);
+    return it == bonds.end() ? 0 : it->second;
+  }
   ShapeSpec shape; ///< the specimen: the vessel at the end of installation, or the cut [m]
   double porosity_target = 0;
   double porosity_packed = 0;    ///< when the friction control reached the target
@@ -31,6 +38,7 @@ struct GenesisReport {
   std::int64_t steps_packing = 0, steps_installation = 0, steps_release = 0;
   double seconds = 0;
   nlohmann::json to_json() const;
+  nlohmann::json contact_counts() const; ///< the report's "contacts"
 };
 
 struct GenesisResult {

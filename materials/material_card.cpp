@@ -88,24 +88,6 @@ ShapeSpec read_shape(JsonObject o, int dim, bool cut) {
   return s;
 }
 
-Distribution read_dist(JsonObject& o, const std::string& key, const char* unit) {
-  Distribution d;
-  if (!o.has(key))
-    o.fail(key, std::string("missing (a number or {\"mean\", \"sd\"} in ") + unit + ")");
-  const auto& v = o.raw(key);
-  if (v.is_number()) {
-    d.mean = v.get<double>();
-    if (d.mean < 0)
-      o.fail(key, "value " + v.dump() + " is out of range [0, +inf) " + unit);
-    return d;
-  }
-  JsonObject m(v, o.file(), o.key_path(key));
-  d.mean = m.number("mean", Range::non_negative(), std::nullopt, unit);
-  d.sd = m.number("sd", Range::non_negative(), 0.0, unit);
-  m.finish();
-  return d;
-}
-
 } // namespace
 
 nlohmann::json shape_json(const ShapeSpec& s, int dim) {
@@ -147,31 +129,6 @@ void apply_overrides(MaterialCard& card, const GenesisOverrides& o) {
 }
 
 namespace {
-
-// A card section holding a contact model's properties: its model keys are read by the model's own
-// reader, the one a scene's contact_models entry uses (one reader, one default per key:
-// docs/scene-format.md); the card reads its own keys (`card_keys`: per-contact distributions,
-// types) itself. In a bond section every model key carries the model's prefix: the bond's
-// linear part is the card's `linear` section, and the bond itself is installed by genesis.
-template <class M>
-typename M::Props read_model_section(JsonObject& top, const std::string& section, int dim,
-                                     const std::string& prefix,
-                                     std::initializer_list<const char*> card_keys) {
-  JsonObject s = top.object(section);
-  nlohmann::json model_keys = top.raw(section); // an object (top.object checked it)
-  for (const char* k : card_keys)
-    model_keys.erase(k);
-  for (auto it = model_keys.begin(); it != model_keys.end(); ++it)
-    if (!prefix.empty() && it.key().rfind(prefix, 0) != 0)
-      s.fail(it.key(), "is not a key of a card's '" + section + "' section (its keys start with '" +
-                           prefix +
-                           "'; the linear part is the card's 'linear' section and "
-                           "genesis installs the bonds)");
-  JsonObject m(model_keys, s.file(), s.path());
-  typename M::Props p = M::read(m, dim);
-  m.finish();
-  return p;
-}
 
 void read_grains(JsonObject& top, MaterialCard& c) {
   JsonObject g = top.object("grains");
@@ -258,53 +215,28 @@ void read_installation(JsonObject& top, MaterialCard& c) {
   i.finish();
 }
 
-// The bonded model of the card: flat joints, parallel bonds, contact bonds or none.
+// The card's bonded model: the one registered model whose card section the card gives (or none).
 void read_bonding(JsonObject& top, MaterialCard& c) {
-  const int bonds = top.has("flatjoint") + top.has("parallelbond") + top.has("contactbond");
-  if (bonds > 1)
-    top.fail("flatjoint", "give one of 'flatjoint', 'parallelbond' or 'contactbond'");
-  if (top.has("flatjoint")) {
-    c.bonding = MaterialCard::Bonding::FlatJoint;
-    c.fj = read_model_section<FlatJoint>(top, "flatjoint", c.dim, "fj_",
-                                         {"fj_ten", "fj_coh", "types"});
-    JsonObject f = top.object("flatjoint");
-    if (!(c.fj.fj_emod > 0 || c.fj.fj_kn > 0))
-      f.fail("fj_emod", "missing: a card's flat joints need a stiffness (fj_emod with fj_kratio, "
-                        "or fj_kn with fj_ks)");
-    if (f.has("fj_gap0"))
-      f.fail("fj_gap0", "is set by genesis on a card: give the gapped contacts' gap as "
-                        "'types.gap'");
-    c.fj_ten = read_dist(f, "fj_ten", "Pa");
-    c.fj_coh = read_dist(f, "fj_coh", "Pa");
-    JsonObject t = f.optional_object("types");
-    c.frac_bonded = t.number("bonded", Range::closed(0, 1), 1.0);
-    c.frac_gapped = t.number("gapped", Range::closed(0, 1), 0.0);
-    c.frac_slit = t.number("slit", Range::closed(0, 1), 0.0);
-    if (std::abs(c.frac_bonded + c.frac_gapped + c.frac_slit - 1) > 1e-9)
-      t.fail("bonded", "the fractions bonded + gapped + slit must sum to 1 (they sum to " +
-                           std::to_string(c.frac_bonded + c.frac_gapped + c.frac_slit) + ")");
-    if (c.frac_gapped > 0)
-      c.gapped_gap = read_dist(t, "gap", "m");
-    t.finish();
-  } else if (top.has("parallelbond")) {
-    c.bonding = MaterialCard::Bonding::ParallelBond;
-    c.pb = read_model_section<LinearPBond>(top, "parallelbond", c.dim, "pb_", {"pb_ten", "pb_coh"});
-    JsonObject p = top.object("parallelbond");
-    if (!(c.pb.pb_emod > 0 || c.pb.pb_kn > 0))
-      p.fail("pb_emod", "missing: a card's parallel bonds need a stiffness (pb_emod with "
-                        "pb_kratio, or pb_kn with pb_ks)");
-    c.pb_ten = read_dist(p, "pb_ten", "Pa");
-    c.pb_coh = read_dist(p, "pb_coh", "Pa");
-  } else if (top.has("contactbond")) {
-    // PFC's contact bond on the linear contact: point-bond strengths in force units.
-    c.bonding = MaterialCard::Bonding::ContactBond;
-    JsonObject b = top.object("contactbond");
-    c.cb_tenf = read_dist(b, "cb_tenf", "N");
-    c.cb_shearf = read_dist(b, "cb_shearf", "N");
-    b.finish();
-  } else {
-    c.bonding = MaterialCard::Bonding::None;
+  std::vector<std::string> all, given;
+  for_each_model([&]<class M>() {
+    if constexpr (BondsCards<M>) {
+      all.emplace_back(M::card_section);
+      if (top.has(all.back()))
+        given.push_back(all.back());
+    }
+  });
+  if (given.size() > 1) {
+    std::string list;
+    for (const auto& s : all)
+      list += (list.empty() ? "'" : ", '") + s + "'";
+    top.fail(given[1], "give one bonded model (" + list + "), not both '" + given[0] + "' and '" +
+                           given[1] + "'");
   }
+  for_each_model([&]<class M>() {
+    if constexpr (BondsCards<M>)
+      if (!given.empty() && given[0] == M::card_section)
+        c.bonding = M::card_bonding(top, c.dim);
+  });
 }
 
 void read_joints(JsonObject& top, MaterialCard& c, const std::string& path) {
@@ -365,7 +297,7 @@ MaterialCard load_material_card(const std::string& path) {
   if (!c.packing_import.empty() && c.clump_max > 0)
     top.fail("clumps", "clumped grains are made by packing; they cannot be combined with an "
                        "imported packing ('packing.import')");
-  c.linear = read_model_section<Linear>(top, "linear", c.dim, "", {});
+  c.linear = read_card_section<Linear>(top, "linear", c.dim, "", {});
   read_bonding(top, c);
   read_joints(top, c, path);
   top.finish();

@@ -1,28 +1,23 @@
 // Material card: what a specimen is made of and how it is made (docs/material-format.md).
-// All quantities SI. A model section's keys are read by the contact model's own reader
-// (read_model_section in the .cpp); the card adds per-contact distributions and types.
-// Recipe, a new bonding choice for cards (a bonded contact model already in the registry):
-// its section in read_bonding (material_card.cpp: read_model_section<Model> with the model's key
-// prefix and the card's own keys), a Bonding value, its branch in genesis/finalization.cpp (the
-// per-contact draws), its count in GenesisReport, and its paragraph in docs/material-format.md.
+// All quantities SI. A model section's keys are read by the contact model's own reader; the
+// card's bonded model reads its section itself (contact/card_bonding.hpp: its distributions,
+// types and the bond it makes at each candidate), found through the registry, so a new bonded
+// model is its files, its registration line and its docs, not an edit here or in genesis.
 #pragma once
 
+#include "contact/card_bonding.hpp"
 #include "contact/registry.hpp"
 #include "core/types.hpp"
 #include "io/json_input.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 namespace rocklab {
-
-/// A property drawn per contact from Normal(mean, sd), clamped at zero.
-struct Distribution {
-  double mean = 0, sd = 0;
-};
 
 enum class SpecimenShape { Rectangle, Disk2D, Prism, Cylinder, Disk3D };
 
@@ -84,14 +79,9 @@ struct MaterialCard {
   std::int64_t stiffness_ramp = 0;
   // contacts
   LinearProps linear; ///< grain-wall, non-bonded and new contacts
-  enum class Bonding { FlatJoint, ParallelBond, ContactBond, None } bonding = Bonding::FlatJoint;
-  FlatJointProps fj;
-  Distribution fj_ten, fj_coh;
-  double frac_bonded = 1, frac_gapped = 0, frac_slit = 0;
-  Distribution gapped_gap; ///< g_o of gapped contacts [m]
-  LinearPBondProps pb;
-  Distribution pb_ten, pb_coh;
-  Distribution cb_tenf, cb_shearf; ///< contact-bond strengths [N] (rock-impact thesis 4.3-4.4)
+  /// The card's bonded model (its section: "flatjoint", "parallelbond", ...); null: none, every
+  /// contact linear.
+  std::shared_ptr<const CardBonding> bonding;
   // release
   double residual_tolerance = 0.05; ///< mean residual stress / pressure after release
   bool eliminate_floaters = false;

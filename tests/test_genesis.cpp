@@ -70,19 +70,24 @@ TEST(Genesis, PorosityStressAndReleaseForEveryShape) {
     EXPECT_NEAR(est, static_cast<double>(r.grains + r.escaped), 0.1 * est) << name;
     EXPECT_GT(r.coordination, c.dim == 2 ? 2.5 : 3.5) << name;
     EXPECT_TRUE(g.model->walls.empty()) << name;
-    if (c.bonding == MaterialCard::Bonding::FlatJoint) {
-      const double n = static_cast<double>(r.fj_bonded + r.fj_gapped + r.fj_slit);
+    if (c.raw.contains("flatjoint")) {
+      const nlohmann::json types = c.raw["flatjoint"].value("types", nlohmann::json::object());
+      const double n = static_cast<double>(
+          r.bonded("flatjoint_bonded") + r.bonded("flatjoint_gapped") + r.bonded("flatjoint_slit"));
       EXPECT_GT(n, 0) << name;
-      EXPECT_NEAR(r.fj_bonded / n, c.frac_bonded, 1.0 / n + 1e-12) << name;
-      EXPECT_NEAR(r.fj_gapped / n, c.frac_gapped, 1.0 / n + 1e-12) << name;
-      EXPECT_NEAR(r.fj_slit / n, c.frac_slit, 1.0 / n + 1e-12) << name;
+      EXPECT_NEAR(r.bonded("flatjoint_bonded") / n, types.value("bonded", 1.0), 1.0 / n + 1e-12)
+          << name;
+      EXPECT_NEAR(r.bonded("flatjoint_gapped") / n, types.value("gapped", 0.0), 1.0 / n + 1e-12)
+          << name;
+      EXPECT_NEAR(r.bonded("flatjoint_slit") / n, types.value("slit", 0.0), 1.0 / n + 1e-12)
+          << name;
       std::int64_t bonded = 0;
       for (const auto& fj : g.model->batches().of<FlatJoint>().contacts)
         bonded += fj.mtype == 1;
-      EXPECT_EQ(bonded, r.fj_bonded) << name;
-    } else if (c.bonding == MaterialCard::Bonding::ContactBond) {
-      EXPECT_GT(r.cb_bonded, 0) << name;
-      EXPECT_EQ(r.pb_bonded, 0) << name;
+      EXPECT_EQ(bonded, r.bonded("flatjoint_bonded")) << name;
+    } else if (c.raw.contains("contactbond")) {
+      EXPECT_GT(r.bonded("contactbond_bonded"), 0) << name;
+      EXPECT_EQ(r.bonded("linearpbond_bonded"), 0) << name;
       std::int64_t bonded = 0;
       double tenf = 0;
       for (const auto& cb : g.model->batches().of<ContactBond>().contacts) {
@@ -93,15 +98,15 @@ TEST(Genesis, PorosityStressAndReleaseForEveryShape) {
       for (const auto& cb : g.model->batches().of<ContactBond>().contacts)
         ++st[static_cast<int>(cb.state)];
       // Every installed bond is still there or broke while the vessel was released (a few).
-      EXPECT_EQ(bonded + st[1] + st[2], r.cb_bonded) << name;
-      EXPECT_LE(st[1] + st[2], r.cb_bonded / 100) << name;
+      EXPECT_EQ(bonded + st[1] + st[2], r.bonded("contactbond_bonded")) << name;
+      EXPECT_LE(st[1] + st[2], r.bonded("contactbond_bonded") / 100) << name;
       EXPECT_NEAR(tenf / static_cast<double>(bonded), 5e4, 1.5e3) << name; // drawn N(5e4, 5e3) N
     } else {
-      EXPECT_GT(r.pb_bonded, 0) << name;
+      EXPECT_GT(r.bonded("linearpbond_bonded"), 0) << name;
       std::int64_t bonded = 0;
       for (const auto& pb : g.model->batches().of<LinearPBond>().contacts)
         bonded += pb.s.state == BondState::Bonded;
-      EXPECT_EQ(bonded, r.pb_bonded) << name;
+      EXPECT_EQ(bonded, r.bonded("linearpbond_bonded")) << name;
     }
   }
 }
@@ -126,7 +131,7 @@ TEST(Genesis, CylinderWithRockStiffness) {
     const FlatJointContact& fj = m.batches().of<FlatJoint>().contacts[ct.slot];
     const double L = m.balls.radius[static_cast<std::size_t>(ct.end1)] +
                      m.balls.radius[static_cast<std::size_t>(ct.end2)];
-    EXPECT_TRUE(near_rel(fj.kn, c.fj.fj_emod / L, 1e-12));
+    EXPECT_TRUE(near_rel(fj.kn, std::get<FlatJointProps>(c.bonding->props()).fj_emod / L, 1e-12));
     ++checked;
   }
   EXPECT_GT(checked, 1000u);
@@ -243,7 +248,9 @@ TEST(Genesis, APackingMarginRatioMakesThePackingIndependentOfTheInstallationGap)
   EXPECT_EQ(a.porosity_installed, b.porosity_installed);
   EXPECT_EQ(a.steps_packing, b.steps_packing);
   EXPECT_EQ(a.steps_installation, b.steps_installation);
-  EXPECT_LT(a.fj_bonded + a.fj_gapped + a.fj_slit, b.fj_bonded + b.fj_gapped + b.fj_slit);
+  EXPECT_LT(
+      a.bonded("flatjoint_bonded") + a.bonded("flatjoint_gapped") + a.bonded("flatjoint_slit"),
+      b.bonded("flatjoint_bonded") + b.bonded("flatjoint_gapped") + b.bonded("flatjoint_slit"));
   const GenesisReport c = run("0.08", false), d = run("0.12", false);
   EXPECT_NE(c.porosity_installed, d.porosity_installed);
   EXPECT_THROW(load_material_card(edited_card("genesis_2d_rect.json", "\"gap_ratio\": 0.05}",
@@ -258,10 +265,11 @@ TEST(Genesis, TypeFractionsOnAThreeThousandGrainSpecimen) {
   const GenesisReport& r = g.report;
   EXPECT_GE(r.grains, 2900);
   EXPECT_NEAR(r.porosity, c.porosity, 0.005);
-  const double n = static_cast<double>(r.fj_bonded + r.fj_gapped + r.fj_slit);
-  EXPECT_NEAR(r.fj_bonded / n, 0.7, 0.02);
-  EXPECT_NEAR(r.fj_gapped / n, 0.2, 0.02);
-  EXPECT_NEAR(r.fj_slit / n, 0.1, 0.02);
+  const double n = static_cast<double>(r.bonded("flatjoint_bonded") + r.bonded("flatjoint_gapped") +
+                                       r.bonded("flatjoint_slit"));
+  EXPECT_NEAR(r.bonded("flatjoint_bonded") / n, 0.7, 0.02);
+  EXPECT_NEAR(r.bonded("flatjoint_gapped") / n, 0.2, 0.02);
+  EXPECT_NEAR(r.bonded("flatjoint_slit") / n, 0.1, 0.02);
   // The model holds the same types; gapped contacts have their initial gap, the others none.
   std::int64_t count[5] = {0, 0, 0, 0, 0};
   for (const auto& fj : g.model->batches().of<FlatJoint>().contacts) {
@@ -271,9 +279,9 @@ TEST(Genesis, TypeFractionsOnAThreeThousandGrainSpecimen) {
     else
       EXPECT_EQ(fj.gap0, 0.0);
   }
-  EXPECT_EQ(count[1], r.fj_bonded);
-  EXPECT_EQ(count[2], r.fj_gapped);
-  EXPECT_EQ(count[3], r.fj_slit);
+  EXPECT_EQ(count[1], r.bonded("flatjoint_bonded"));
+  EXPECT_EQ(count[2], r.bonded("flatjoint_gapped"));
+  EXPECT_EQ(count[3], r.bonded("flatjoint_slit"));
 }
 
 TEST(Genesis, FloatersAreCountedAndCanBeEliminated) {
@@ -485,7 +493,7 @@ TEST(Genesis, ClumpedContactBondedSpecimen) {
       const std::int32_t a = m.balls.clump[static_cast<std::size_t>(ct.end1)];
       EXPECT_TRUE(a < 0 || a != m.balls.clump[static_cast<std::size_t>(ct.end2)]);
     }
-  EXPECT_GT(g.report.cb_bonded, 100);
+  EXPECT_GT(g.report.bonded("contactbond_bonded"), 100);
   EXPECT_NEAR(g.report.porosity, c.porosity, 0.005);
   // The specimen file keeps the clumps.
   const fs::path f = scratch("clumped");
@@ -549,9 +557,10 @@ TEST(Genesis, ImportedPackingIsFinalizedLikeAPackedOne) {
   }
   EXPECT_LT(worst, 0.05 * r_avg);
   const GenesisReport& r = h.report;
-  EXPECT_NEAR(static_cast<double>(r.fj_bonded + r.fj_gapped + r.fj_slit),
+  EXPECT_NEAR(static_cast<double>(r.bonded("flatjoint_bonded") + r.bonded("flatjoint_gapped") +
+                                  r.bonded("flatjoint_slit")),
               static_cast<double>(within), 1.0);
-  EXPECT_GT(r.fj_bonded, 0);
+  EXPECT_GT(r.bonded("flatjoint_bonded"), 0);
   EXPECT_EQ(r.shape.shape, SpecimenShape::Rectangle);
   EXPECT_TRUE(near_rel(r.shape.size.x(), hi.x() - lo.x(), 1e-9));
   EXPECT_TRUE(near_rel(r.shape.size.y(), hi.y() - lo.y(), 1e-9));
@@ -614,6 +623,9 @@ TEST(Genesis, PerContactDrawsKeepEveryContactWhenTheGapRatioMoves) {
   EXPECT_LT(static_cast<double>(same), 0.2 * static_cast<double>(common))
       << same << " of " << common;
   const GenesisResult g = make(true, "0.05");
-  const double n = static_cast<double>(g.report.fj_bonded + g.report.fj_gapped + g.report.fj_slit);
-  EXPECT_NEAR(static_cast<double>(g.report.fj_bonded) / n, 0.8, 3 * std::sqrt(0.16 / n));
+  const double n =
+      static_cast<double>(g.report.bonded("flatjoint_bonded") +
+                          g.report.bonded("flatjoint_gapped") + g.report.bonded("flatjoint_slit"));
+  EXPECT_NEAR(static_cast<double>(g.report.bonded("flatjoint_bonded")) / n, 0.8,
+              3 * std::sqrt(0.16 / n));
 }

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <thread>
 
 namespace fs = std::filesystem;
@@ -53,6 +54,18 @@ template <class M> typename M::Props scene_read(const json& keys, int dim) {
   return p;
 }
 
+// A card's bond section as its model read it: the properties and the distributions by key.
+template <class P> struct BondSection {
+  P props;
+  std::map<std::string, Distribution> dist;
+};
+template <class P> BondSection<P> bond_section(const MaterialCard& card) {
+  BondSection<P> s{std::get<P>(card.bonding->props()), {}};
+  for (const auto& [key, d] : card.bonding->distributions())
+    s.dist[key] = d;
+  return s;
+}
+
 } // namespace
 
 TEST(MaterialCard, ModelKeysMeanTheSameInACardAndInAScene) {
@@ -60,19 +73,20 @@ TEST(MaterialCard, ModelKeysMeanTheSameInACardAndInAScene) {
     // Defaults: a card giving only a stiffness and strengths takes the model's defaults, as a
     // scene does (fj_Nr 2 in 2D too: the memo's Table 5, where a 2D card used to say 4).
     const json fj = {{"fj_emod", 2e9}, {"fj_ten", 1e6}, {"fj_coh", 2e6}};
-    const MaterialCard c = load_material_card(card_with("flatjoint", fj, dim));
+    const MaterialCard card = load_material_card(card_with("flatjoint", fj, dim));
+    const auto c = bond_section<FlatJointProps>(card);
     const FlatJointProps s = scene_read<FlatJoint>({{"fj_emod", 2e9}}, dim);
-    EXPECT_EQ(c.fj.fj_Nr, 2);
-    EXPECT_EQ(c.fj.fj_Nr, s.fj_Nr);
-    EXPECT_EQ(c.fj.fj_Nal, s.fj_Nal);
-    EXPECT_EQ(c.fj.fj_kratio, 0.0); // was required on a card
-    EXPECT_EQ(c.fj.fj_kratio, s.fj_kratio);
-    EXPECT_EQ(c.fj.fj_rmul, s.fj_rmul);
-    EXPECT_EQ(c.fj.fj_fric, s.fj_fric);
-    EXPECT_EQ(c.fj.fj_fa, s.fj_fa);
-    EXPECT_EQ(c.fj.fj_exact, s.fj_exact);
-    EXPECT_EQ(c.fj_ten.mean, 1e6);
-    EXPECT_EQ(c.fj_coh.mean, 2e6);
+    EXPECT_EQ(c.props.fj_Nr, 2);
+    EXPECT_EQ(c.props.fj_Nr, s.fj_Nr);
+    EXPECT_EQ(c.props.fj_Nal, s.fj_Nal);
+    EXPECT_EQ(c.props.fj_kratio, 0.0); // was required on a card
+    EXPECT_EQ(c.props.fj_kratio, s.fj_kratio);
+    EXPECT_EQ(c.props.fj_rmul, s.fj_rmul);
+    EXPECT_EQ(c.props.fj_fric, s.fj_fric);
+    EXPECT_EQ(c.props.fj_fa, s.fj_fa);
+    EXPECT_EQ(c.props.fj_exact, s.fj_exact);
+    EXPECT_EQ(c.dist.at("fj_ten").mean, 1e6);
+    EXPECT_EQ(c.dist.at("fj_coh").mean, 2e6);
     // Given values arrive unchanged, and the stiffness pair may be given either way.
     json given = {{"fj_Nr", 3},
                   {"fj_rmul", 0.8},
@@ -84,28 +98,29 @@ TEST(MaterialCard, ModelKeysMeanTheSameInACardAndInAScene) {
                   {"fj_coh", 3e6}};
     if (dim == 3)
       given["fj_Nal"] = 6;
-    const MaterialCard g = load_material_card(card_with("flatjoint", given, dim));
+    const auto g =
+        bond_section<FlatJointProps>(load_material_card(card_with("flatjoint", given, dim)));
     json scene_keys = given;
     scene_keys.erase("fj_ten");
     scene_keys.erase("fj_coh");
     const FlatJointProps gs = scene_read<FlatJoint>(scene_keys, dim);
-    EXPECT_EQ(g.fj.fj_Nr, 3);
-    EXPECT_EQ(g.fj.fj_Nal, dim == 3 ? 6 : gs.fj_Nal);
-    EXPECT_EQ(g.fj.fj_Nal, gs.fj_Nal);
-    EXPECT_EQ(g.fj.fj_rmul, 0.8);
-    EXPECT_EQ(g.fj.fj_kn, 4e12);
-    EXPECT_EQ(g.fj.fj_ks, gs.fj_ks);
-    EXPECT_EQ(g.fj.fj_emod, 0.0);
-    EXPECT_EQ(g.fj.fj_fa, 25.0);
-    EXPECT_EQ(g.fj_ten.sd, 1e5);
+    EXPECT_EQ(g.props.fj_Nr, 3);
+    EXPECT_EQ(g.props.fj_Nal, dim == 3 ? 6 : gs.fj_Nal);
+    EXPECT_EQ(g.props.fj_Nal, gs.fj_Nal);
+    EXPECT_EQ(g.props.fj_rmul, 0.8);
+    EXPECT_EQ(g.props.fj_kn, 4e12);
+    EXPECT_EQ(g.props.fj_ks, gs.fj_ks);
+    EXPECT_EQ(g.props.fj_emod, 0.0);
+    EXPECT_EQ(g.props.fj_fa, 25.0);
+    EXPECT_EQ(g.dist.at("fj_ten").sd, 1e5);
     // Parallel bonds likewise (pb_kratio was required on a card, 0 in a scene).
-    const MaterialCard p = load_material_card(
-        card_with("parallelbond", {{"pb_emod", 5e10}, {"pb_ten", 1e7}, {"pb_coh", 2e7}}, dim));
+    const auto p = bond_section<LinearPBondProps>(load_material_card(
+        card_with("parallelbond", {{"pb_emod", 5e10}, {"pb_ten", 1e7}, {"pb_coh", 2e7}}, dim)));
     const LinearPBondProps ps = scene_read<LinearPBond>({{"pb_emod", 5e10}}, dim);
-    EXPECT_EQ(p.pb.pb_kratio, ps.pb_kratio);
-    EXPECT_EQ(p.pb.pb_mcf, ps.pb_mcf);
-    EXPECT_EQ(p.pb.pb_rmul, ps.pb_rmul);
-    EXPECT_EQ(p.pb_ten.mean, 1e7);
+    EXPECT_EQ(p.props.pb_kratio, ps.pb_kratio);
+    EXPECT_EQ(p.props.pb_mcf, ps.pb_mcf);
+    EXPECT_EQ(p.props.pb_rmul, ps.pb_rmul);
+    EXPECT_EQ(p.dist.at("pb_ten").mean, 1e7);
     // The linear section is the linear model's keys, those a scene may give included.
     const MaterialCard l = load_material_card(
         card_with("linear", {{"kn", 1e7}, {"ks", 5e6}, {"fric", 0.3}, {"rgap", 1e-6}}, dim));
@@ -138,6 +153,13 @@ TEST(MaterialCard, KeysGenesisSetsAndMissingStiffnessAreRefusedNamingTheKey) {
   json typo = strengths;
   typo["fj_tens"] = 1e6;
   EXPECT_NE(card_error(card_with("flatjoint", typo)).find("flatjoint.fj_tens"), std::string::npos);
+  // One bonded model per card, whichever two are given; the error names both.
+  json both_models = read_json_file(card_with("flatjoint", strengths));
+  both_models["contactbond"] = {{"cb_tenf", 1.0}, {"cb_shearf", 1.0}};
+  const fs::path two = test::scratch_root() / "card-two-bonded-models.json";
+  std::ofstream(two) << both_models.dump(1);
+  const std::string two_error = card_error(two.string());
+  EXPECT_NE(two_error.find("'flatjoint' and 'contactbond'"), std::string::npos) << two_error;
   // 2D flat joints have no circumferential elements.
   json nal = strengths;
   nal["fj_Nal"] = 4;
@@ -169,7 +191,8 @@ TEST(MaterialCard, AnInputGivenAsTextReadsLikeItsFileAndIsNamedInErrors) {
     const MaterialCard from_text = load_material_card("<card dict>");
     EXPECT_EQ(from_text.name, from_file.name);
     EXPECT_EQ(from_text.porosity, from_file.porosity);
-    EXPECT_EQ(from_text.fj_ten.mean, from_file.fj_ten.mean);
+    EXPECT_EQ(bond_section<FlatJointProps>(from_text).dist.at("fj_ten").mean,
+              bond_section<FlatJointProps>(from_file).dist.at("fj_ten").mean);
     card["porosity"] = 1.5;
     const InputText inner("<card dict>", card.dump()); // the latest given wins
     try {

@@ -81,7 +81,7 @@ def card_for(args, material, setting):
     node = card
     for k in path:
         node = node.setdefault(k, {})
-    node[last] = float(setting)
+    node[last] = int(setting) if setting.lstrip("-").isdigit() else float(setting)
     out = os.path.join(args.out, "cards", "%s_%s.json" % (os.path.basename(material)[:-5],
                                                            setting))
     os.makedirs(os.path.dirname(out), exist_ok=True)
@@ -180,6 +180,31 @@ def num(x):
         return float("nan")
 
 
+def mean_ci(xs):
+    """The mean of paired differences and the half-width of its 95 % Student-t interval."""
+    n = len(xs)
+    if n == 0:
+        return float("nan"), float("nan")
+    m = sum(xs) / n
+    if n == 1:
+        return m, float("nan")
+    sd = math.sqrt(sum((x - m) ** 2 for x in xs) / (n - 1))
+    return m, t95(n - 1) * sd / math.sqrt(n)
+
+
+def spread(xs, scale, fmt):
+    """A property's paired shift: mean +- 95 % half-width, and the largest single pair."""
+    fin = [x for x in xs if math.isfinite(x)]
+    if not fin:
+        return "-"
+    m, h = mean_ci(fin)
+    largest = max(fin, key=abs)
+    if len(fin) == 1:
+        return (fmt % (scale * m)) + " (one pair)"
+    return "%s +- %s (largest %s)" % (fmt % (scale * m), (fmt % (scale * h)).lstrip("+"),
+                                      fmt % (scale * largest))
+
+
 def window_fit(run_dir, window):
     """E and nu by least squares over the loading branch between two deviator levels [Pa] (the
     base run's elastic window), from history.csv: the same stresses in both runs of a pair, so a
@@ -213,7 +238,8 @@ def cmd_report(args):
     groups = {}
     for r in rows:
         groups.setdefault((r["preset"], r["test"]), {}).setdefault(r["seed"], {})[r["setting"]] = r
-    print("| preset | test | setting | seeds | E shift (same window) | nu shift | strength shift, mean "
+    print("| preset | test | setting | seeds | E shift, mean +- 95 % (same window) | nu shift, mean "
+          "+- 95 % | strength shift, mean "
           "[95 % interval] | within +-half tolerance | largest ledger error (at the base) | loading steps |")
     print("|---|---|---|---|---|---|---|---|---|---|")
     for (preset, test), by_seed in sorted(groups.items()):
@@ -251,18 +277,13 @@ def cmd_report(args):
             n = len(ds)
             if n == 0:
                 continue
-            m = sum(ds) / n
-            sd = math.sqrt(sum((x - m) ** 2 for x in ds) / (n - 1)) if n > 1 else float("nan")
-            h = t95(n - 1) * sd / math.sqrt(n) if n > 1 else float("nan")
+            m, h = mean_ci(ds)
             half = HALF_TOLERANCE.get(test, 0.025)
             ok = n >= 6 and abs(m) + h <= half
-            fin = [x for x in de if math.isfinite(x)]
-            fin_n = [x for x in dn if math.isfinite(x)]
             interval = "[%+.2f, %+.2f]" % (100 * (m - h), 100 * (m + h)) if n > 1 else "(one pair)"
             print("| %s | %s | %s | %d | %s | %s | %+.2f %% %s | %s | %.3f %% (%.3f %%) | %s |" % (
                 preset, test, s, n,
-                "%+.3f %% max" % (100 * max(fin, key=abs)) if fin else "-",
-                "%+.4f max" % max(fin_n, key=abs) if fin_n else "-",
+                spread(de, 100, "%+.3f %%"), spread(dn, 1, "%+.4f"),
                 100 * m, interval,
                 ("yes" if ok else "no") + ("" if n >= 6 else " (fewer than 6 seeds)"),
                 100 * max(ledger) if ledger else float("nan"),

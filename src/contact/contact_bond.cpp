@@ -1,5 +1,7 @@
 #include "contact/contact_bond.hpp"
 
+#include "contact/card_bonding.hpp"
+
 #include "io/json_input.hpp"
 
 namespace rocklab {
@@ -41,6 +43,47 @@ ContactBond::Props ContactBond::read(JsonObject& p, int) {
   const BondOption b = read_bond_option(p, true);
   cb.bond = b.bond, cb.bond_gap_lo = b.lo, cb.bond_gap_hi = b.hi, cb.bond_gap_ratio = b.ratio;
   return cb;
+}
+
+namespace {
+
+class ContactBondCard final : public CardBonding {
+public:
+  explicit ContactBondCard(JsonObject& top) {
+    // PFC's contact bond on the linear contact: point-bond strengths in force units.
+    JsonObject b = top.object("contactbond");
+    tenf_ = read_distribution(b, "cb_tenf", "N");
+    shearf_ = read_distribution(b, "cb_shearf", "N");
+    b.finish();
+  }
+  // Draws: the tensile, then the shear strength force.
+  CardBond bond(BondDraws& d, const BondSite& site) const override {
+    ContactBondProps cb;
+    // A point bond made across an open gap would start in tension (its normal force is
+    // kn (g - g_r)); the reference gap makes the bonded gap the contact's rest state.
+    cb.linear.rgap = std::max(site.gap, 0.0);
+    cb.cb_tenf = d.normal(tenf_);
+    cb.cb_shearf = d.normal(shearf_);
+    return {bonded_on_card_linear(cb, site), ContactBond::card_counts[0]};
+  }
+  ModelProps props() const override {
+    ContactBondProps cb;
+    cb.cb_tenf = tenf_.mean;
+    cb.cb_shearf = shearf_.mean;
+    return cb;
+  }
+  std::vector<std::pair<std::string, Distribution>> distributions() const override {
+    return {{"cb_tenf", tenf_}, {"cb_shearf", shearf_}};
+  }
+
+private:
+  Distribution tenf_, shearf_;
+};
+
+} // namespace
+
+std::unique_ptr<CardBonding> ContactBond::card_bonding(JsonObject& top, int) {
+  return std::make_unique<ContactBondCard>(top);
 }
 
 nlohmann::json ContactBond::state_json(const Contact& cb, int) {

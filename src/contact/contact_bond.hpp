@@ -98,6 +98,11 @@ struct ContactBond {
       c.state = m.name == "bond" ? BondState::Bonded : BondState::None;
   }
   static Props read(JsonObject& p, int dim);
+  /// A card's "contactbond" section (card_bonding.hpp): every candidate point-bonded on the card's
+  /// linear part at its gap, the two strength forces drawn per contact.
+  static constexpr std::string_view card_section = "contactbond";
+  static constexpr std::string_view card_counts[] = {"bonded"};
+  static std::unique_ptr<CardBonding> card_bonding(JsonObject& top, int dim);
   static nlohmann::json state_json(const Contact& c, int dim);
 
   template <class A> static void io(A& a, Props& p) {

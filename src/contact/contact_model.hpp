@@ -33,11 +33,13 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string_view>
 
 namespace rocklab {
 
 class JsonObject;
+class CardBonding; ///< a model's card handling (card_bonding.hpp)
 
 /// Kinematic input of one force-displacement update, in contact-plane coordinates
 /// (FJ memo Eq. 2 and 11). 2D: d_dss = d_tt = d_tbt = 0 and d_tbs = -d_theta_z.

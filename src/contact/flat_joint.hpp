@@ -10,6 +10,7 @@
 #include <array>
 #include <cassert>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -189,6 +190,11 @@ struct FlatJoint {
   static void call(Contact& c, Elements e, const MethodArgs& args);
   static Props read(JsonObject& p, int dim);
   static nlohmann::json state_json(const Contact& c, ConstElements e, int dim);
+  /// A card's "flatjoint" section (card_bonding.hpp, flat_joint_card.cpp): each candidate is
+  /// bonded, gapped or slit by the card's fractions, its strengths drawn per contact.
+  static constexpr std::string_view card_section = "flatjoint";
+  static constexpr std::string_view card_counts[] = {"bonded", "gapped", "slit"};
+  static std::unique_ptr<CardBonding> card_bonding(JsonObject& top, int dim);
 
   template <class A> static void io(A& a, Props& p) {
     a(p.fj_Nr), a(p.fj_Nal), a(p.fj_rmul), a(p.fj_gap0), a(p.fj_kn), a(p.fj_ks), a(p.fj_fric),

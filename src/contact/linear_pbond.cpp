@@ -1,5 +1,6 @@
 #include "contact/linear_pbond.hpp"
 
+#include "contact/card_bonding.hpp"
 #include "io/json_input.hpp"
 
 #include <algorithm>
@@ -182,6 +183,47 @@ LinearPBond::Props LinearPBond::read(JsonObject& p, int) {
   const BondOption b = read_bond_option(p, true);
   pb.bond = b.bond, pb.bond_gap_lo = b.lo, pb.bond_gap_hi = b.hi, pb.bond_gap_ratio = b.ratio;
   return pb;
+}
+
+namespace {
+
+class ParallelBondCard final : public CardBonding {
+public:
+  ParallelBondCard(JsonObject& top, int dim) {
+    pb_ = read_card_section<LinearPBond>(top, "parallelbond", dim, "pb_", {"pb_ten", "pb_coh"});
+    JsonObject p = top.object("parallelbond");
+    if (!(pb_.pb_emod > 0 || pb_.pb_kn > 0))
+      p.fail("pb_emod", "missing: a card's parallel bonds need a stiffness (pb_emod with "
+                        "pb_kratio, or pb_kn with pb_ks)");
+    ten_ = read_distribution(p, "pb_ten", "Pa");
+    coh_ = read_distribution(p, "pb_coh", "Pa");
+  }
+  // Draws: tension, then cohesion.
+  CardBond bond(BondDraws& d, const BondSite& site) const override {
+    LinearPBondProps pb = pb_;
+    pb.pb_ten = d.normal(ten_);
+    pb.pb_coh = d.normal(coh_);
+    return {bonded_on_card_linear(pb, site), LinearPBond::card_counts[0]};
+  }
+  ModelProps props() const override {
+    LinearPBondProps pb = pb_;
+    pb.pb_ten = ten_.mean;
+    pb.pb_coh = coh_.mean;
+    return pb;
+  }
+  std::vector<std::pair<std::string, Distribution>> distributions() const override {
+    return {{"pb_ten", ten_}, {"pb_coh", coh_}};
+  }
+
+private:
+  LinearPBondProps pb_;
+  Distribution ten_, coh_;
+};
+
+} // namespace
+
+std::unique_ptr<CardBonding> LinearPBond::card_bonding(JsonObject& top, int dim) {
+  return std::make_unique<ParallelBondCard>(top, dim);
 }
 
 nlohmann::json LinearPBond::state_json(const Contact& c, int) {

@@ -90,6 +90,11 @@ struct LinearPBond {
   }
   static Props read(JsonObject& p, int dim);
   static nlohmann::json state_json(const Contact& c, int dim);
+  /// A card's "parallelbond" section (card_bonding.hpp): every candidate bonded on the card's
+  /// linear part, tension and cohesion drawn per contact.
+  static constexpr std::string_view card_section = "parallelbond";
+  static constexpr std::string_view card_counts[] = {"bonded"};
+  static std::unique_ptr<CardBonding> card_bonding(JsonObject& top, int dim);
 
   template <class A> static void io(A& a, Props& p) {
     Linear::io(a, p.linear);
