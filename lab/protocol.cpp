@@ -84,7 +84,7 @@ void refuse_other_tests_keys(JsonObject& section, const FrameTest& test) {
 } // namespace
 
 Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
-                            const std::string& key_path) {
+                            const std::string& key_path, std::shared_ptr<FrameTest> test_object) {
   Protocol p;
   p.file = file;
   p.raw = j;
@@ -93,8 +93,11 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
   p.name = top.string("name", "");
   top.string("description", "");
   p.test = top.choice("test", frame_test_names());
-  p.frame_test = make_frame_test(p.test);
+  p.frame_test = test_object ? std::move(test_object) : make_frame_test(p.test);
   FrameTest& test = *p.frame_test;
+  if (test.name() != p.test)
+    throw std::logic_error("a " + std::string(test.name()) + " test object was given a " + p.test +
+                           " protocol");
   {
     if (!top.has("specimen"))
       top.fail("specimen", "missing: give {\"file\": SPECIMEN} or {\"material\": CARD}");

@@ -67,8 +67,10 @@ struct Protocol {
 /// value and allowed range.
 Protocol load_protocol(const std::string& path);
 /// Read a protocol from JSON (suites embed them); `file` locates relative paths and errors.
+/// `test`: the test object that reads the protocol's options and runs it (one of the protocol's
+/// "test" kind; null: made here).
 Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
-                            const std::string& key_path);
+                            const std::string& key_path, std::shared_ptr<FrameTest> test = nullptr);
 
 /// A path written in an input file, relative to that file's folder (absolute paths stay).
 std::string resolve(const std::string& file, const std::string& p);
