@@ -31,7 +31,7 @@ void read_common_loading(JsonObject& l, Protocol& p) {
   p.density_scaling = l.number("density_scaling", Range::half_open(0, 1), 0.0);
   if (l.has("timestep_safety"))
     p.timestep_safety = l.number("timestep_safety", {0, 1.6, true, false}, std::nullopt);
-  if (l.has("platen_friction"))
+  if (l.has("platen_friction")) // the one reader of the key; the actuators take it from here
     p.platen_friction = l.number("platen_friction", Range::closed(0, 10), std::nullopt);
 }
 

@@ -36,9 +36,10 @@ struct Protocol {
   double platen_velocity = 0;              ///< > 0: speed of each platen (or grip) [m/s]
   std::int64_t ramp_steps = 2000;          ///< the platen speed rises smoothly over this many steps
   double seating_stress = 1e5;             ///< platens first close to this axial stress [Pa]
-  /// >= 0: the platens' ball-facet friction coefficient (0 lubricated, steel on rock unlubricated
-  /// about 0.2-0.5); < 0: the test's own (UCS, triaxial: 0; Brazilian: the specimen's wall rule).
-  double platen_friction = -1;
+  /// `loading.platen_friction`, the platens' ball-facet friction coefficient (0 lubricated, steel
+  /// on rock unlubricated about 0.2-0.5); not given: the test's own (FrameTest::actuator: UCS,
+  /// triaxial lubricated; Brazilian the specimen's wall rule).
+  std::optional<double> platen_friction;
   /// > 0: density scaling from the start of loading, the time step raised to this quantile of
   /// the grains' own stable steps (Model::scale_density); 0: off.
   double density_scaling = 0;

@@ -54,8 +54,8 @@ void Platens::mount(Model& m, const SpecimenGeometry& g, const LinearProps& cont
   // loading.platen_friction: end friction of unlubricated platens (the confining walls, a
   // membrane, stay as the test has them).
   LinearProps props = contact;
-  if (friction_ >= 0)
-    props.fric = friction_;
+  if (friction_)
+    props.fric = *friction_;
   // A cushion (loading.platen_stiffness_ratio): every platen contact softer by the same factor,
   // whether its stiffness is given (kn, ks) or follows from the modulus (deformability).
   props.kn *= stiffness_;

@@ -13,8 +13,11 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kServoIntegralSteps = 100; ///< integral time of the confining servo [steps]
 } // namespace
 
-void ConfiningWalls::mount(Model& m, const SpecimenGeometry& g, const LinearProps& props) {
-  // A cylinder around a round specimen, plates on the faces of a prism (2D: on the sides).
+void ConfiningWalls::mount(Model& m, const SpecimenGeometry& g, const LinearProps& contact) {
+  // A cylinder around a round specimen, plates on the faces of a prism (2D: on the sides),
+  // frictionless: a lubricated membrane.
+  LinearProps props = contact;
+  props.fric = 0;
   const Vec3 e = unit_axis(g.axis);
   if (g.round) {
     Wall w;

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,9 +61,9 @@ public:
 class Platens final : public Actuator {
 public:
   /// jaw_ratio > 0: ISRM curved jaws of this times the disk's radius (diametral specimens);
-  /// friction >= 0: the platens' ball-facet friction coefficient, else the contact's own;
+  /// friction: the platens' ball-facet friction coefficient (none: the contact's own);
   /// stiffness: the platens' contact stiffness over the contact's own, (0, 1] (< 1: a cushion).
-  Platens(double jaw_ratio, double friction, double stiffness = 1)
+  Platens(double jaw_ratio, std::optional<double> friction, double stiffness = 1)
       : jaw_ratio_(jaw_ratio), friction_(friction), stiffness_(stiffness) {}
   void mount(Model& m, const SpecimenGeometry& g, const LinearProps& contact,
              const std::string& file) override;
@@ -77,7 +78,9 @@ public:
 private:
   Wall curved_jaw(const Model& m, const SpecimenGeometry& g, const std::string& name,
                   int side) const;
-  double jaw_ratio_, friction_, stiffness_;
+  double jaw_ratio_;
+  std::optional<double> friction_;
+  double stiffness_;
   std::int64_t top_ = -1, bottom_ = -1;
 };
 

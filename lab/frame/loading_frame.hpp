@@ -47,7 +47,6 @@ struct FrameSetup {
   bool diametral = false; ///< a disk loaded across its diameter (y axis), else along the axis
   double confinement = 0; ///< > 0: confining walls hold this stress [Pa]
   double confinement_tolerance = 0.01; ///< the confining phase's band [-]
-  bool platen_friction = false; ///< platens keep the specimen's wall friction (else lubricated)
   Phase first_phase = kSeat;    ///< kConfine, kSeat (platens close to the seating stress) or kLoad
   double reverse_at_strain = 0; ///< > 0: unload from this axial strain back to zero [-]
 };
@@ -151,7 +150,7 @@ private:
   // setup.cpp
   void measure_specimen(const std::string& shape, bool diametral);
   void check_reachable_strain() const;
-  LinearProps platen_contact(bool friction) const;
+  LinearProps wall_contact() const;
   void find_shell();
   // measure.cpp
   void measure(LabSample& s) const;

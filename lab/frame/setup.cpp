@@ -39,7 +39,7 @@ void LoadingFrame::setup() {
   test_.read_specimen(spec);
   reference_ = m_.balls.pos;
   m_.balls.track_orientation(p_.orientation); // rotations count from here, like displacements
-  const LinearProps props = platen_contact(setup.platen_friction);
+  const LinearProps props = wall_contact();   // each fixture sets its own friction
   actuator_->mount(m_, geo_, props, p_.file);
   if (setup.confinement > 0)
     confinement_.mount(m_, geo_, props);
@@ -118,17 +118,13 @@ void LoadingFrame::measure_specimen(const std::string& shape, bool diametral) {
   }
 }
 
-LinearProps LoadingFrame::platen_contact(bool friction) const {
-  // Contacts with the machine's walls: the specimen's ball-facet linear model, frictionless
-  // (lubricated platens) unless the test keeps the specimen's wall friction (Brazilian: between
-  // frictionless flat platens a disk is unstable and slides out sideways).
+LinearProps LoadingFrame::wall_contact() const {
+  // Contacts with the machine's walls: the specimen's ball-facet linear model; the platens'
+  // friction is theirs to set (loading.platen_friction or the test's own), the confining walls'
+  // is zero (a lubricated membrane).
   for (const ModelRule& r : m_.rules)
-    if (r.ball_facet && r.wall == -1 && std::holds_alternative<LinearProps>(r.props)) {
-      LinearProps props = std::get<LinearProps>(r.props);
-      if (!friction)
-        props.fric = 0;
-      return props;
-    }
+    if (r.ball_facet && r.wall == -1 && std::holds_alternative<LinearProps>(r.props))
+      return std::get<LinearProps>(r.props);
   throw InputError(p_.file + ": the specimen has no linear ball-facet contact rule for the "
                              "platens (specimens made by rocklab genesis have one)");
 }

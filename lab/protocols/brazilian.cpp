@@ -71,10 +71,11 @@ public:
   FrameSetup setup() const override {
     FrameSetup s;
     s.diametral = true;
-    s.platen_friction = true;
     return s;
   }
   std::unique_ptr<Actuator> actuator(const Protocol& p) const override {
+    // Platens keep the specimen's wall friction unless the protocol gives one: between
+    // frictionless flat platens a disk is unstable and slides out sideways.
     return std::make_unique<Platens>(jaw_ratio_, p.platen_friction, cushion_);
   }
 

@@ -16,7 +16,7 @@ public:
   const char* name() const override { return "direct_tension"; }
   void read_options(JsonObject& loading, JsonObject&, const Protocol& p) override {
     grip_fraction_ = loading.number("grip_fraction", {0, 0.4, true, false}, 0.1);
-    if (p.platen_friction >= 0)
+    if (p.platen_friction)
       loading.fail("platen_friction", "a direct tension test has grips, not platens");
   }
   FrameSetup setup() const override {

@@ -10,7 +10,7 @@
 namespace rocklab {
 
 std::unique_ptr<Actuator> FrameTest::actuator(const Protocol& p) const {
-  return std::make_unique<Platens>(0.0, p.platen_friction);
+  return std::make_unique<Platens>(0.0, p.platen_friction.value_or(0.0)); // lubricated by default
 }
 
 void FrameTest::check_shape(const std::string& shape, const Protocol& p) const {
