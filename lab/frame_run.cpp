@@ -430,13 +430,22 @@ void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
                 shown("youngs_modulus_Pa", "%.4g GPa", 1e-9).c_str(),
                 shown("youngs_modulus_secant_Pa", "%.4g GPa", 1e-9).c_str(),
                 shown("poisson_ratio", "%.3f", 1).c_str());
-    auto ratio = [&](const char* key) { return json_number(r["crack_stresses"], key, 0.0); };
+    // A crack stress no crack marked (no cracks before the peak, a volume still falling) is
+    // null in results.json and "not measured" here, not 0 MPa.
+    auto stress_and_ratio = [&](const char* key, const char* ratio_key) {
+      const std::string s = shown(key, "%.4g MPa", 1e-6);
+      const auto& c = r["crack_stresses"];
+      if (!c.contains(ratio_key) || !c[ratio_key].is_number())
+        return s;
+      char b[32];
+      std::snprintf(b, sizeof b, " (%.2f of peak)", c[ratio_key].get<double>());
+      return s + b;
+    };
     if (r.contains("crack_stresses"))
-      std::printf("crack stress initiation %.4g MPa (%.2f of peak; volumetric %.4g MPa), damage "
-                  "%.4g MPa (%.2f)\n",
-                  mpa("crack_initiation_stress_Pa"), ratio("crack_initiation_ratio"),
-                  mpa("crack_initiation_stress_volumetric_Pa"), mpa("crack_damage_stress_Pa"),
-                  ratio("crack_damage_ratio"));
+      std::printf("crack stress initiation %s, volumetric %s; damage %s\n",
+                  stress_and_ratio("crack_initiation_stress_Pa", "crack_initiation_ratio").c_str(),
+                  shown("crack_initiation_stress_volumetric_Pa", "%.4g MPa", 1e-6).c_str(),
+                  stress_and_ratio("crack_damage_stress_Pa", "crack_damage_ratio").c_str());
   }
   print_results(r);
   const auto& c = r["cracks"];

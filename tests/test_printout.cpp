@@ -148,3 +148,39 @@ TEST(Printout, EveryDeclaredSuitePropertyIsAColumnOfTheSuiteTables) {
       << none;
   EXPECT_EQ(none.find("Hoek-Brown m_i"), std::string::npos) << none;
 }
+
+TEST(Printout, ACrackStressNoCrackMarkedReadsNotMeasuredNotZero) {
+  // A UCS without cracks before the peak (the 2D contact-bonded Berea to 2 % strain) has null
+  // crack stresses in results.json; the printout said "0 MPa (0.00 of peak)".
+  LabSummary s;
+  s.results = {
+      {"test", "ucs"},
+      {"provenance", {{"material", "card"}, {"grains", 10}, {"steps", 100}}},
+      {"peak_stress_Pa", 2e8},
+      {"peak_deviator_Pa", 2e8},
+      {"peak_axial_strain", 0.003},
+      {"youngs_modulus_Pa", 7e10},
+      {"crack_initiation_stress_Pa", nullptr},
+      {"crack_initiation_stress_volumetric_Pa", nullptr},
+      {"crack_damage_stress_Pa", nullptr},
+      {"crack_stresses", {{"crack_initiation_ratio", nullptr}, {"crack_damage_ratio", nullptr}}},
+      {"cracks", {{"tension", 0}, {"shear", 0}, {"at_peak", {{"total", 0}}}}},
+      {"stop_reason", "stop.strain_limit reached"},
+      {"files", json::array()}};
+  const auto t = make_frame_test("ucs");
+  auto line = [&] {
+    testing::internal::CaptureStdout();
+    t->print(s, "out");
+    const std::string all = testing::internal::GetCapturedStdout();
+    const auto a = all.find("crack stress");
+    return a == std::string::npos ? all : all.substr(a, all.find('\n', a) - a);
+  };
+  EXPECT_EQ(line(),
+            "crack stress initiation not measured, volumetric not measured; damage not measured");
+  s.results["crack_initiation_stress_Pa"] = 9e7;
+  s.results["crack_initiation_stress_volumetric_Pa"] = 8e7;
+  s.results["crack_damage_stress_Pa"] = 1.5e8;
+  s.results["crack_stresses"] = {{"crack_initiation_ratio", 0.45}, {"crack_damage_ratio", 0.75}};
+  EXPECT_EQ(line(), "crack stress initiation 90 MPa (0.45 of peak), volumetric 80 MPa; damage "
+                    "150 MPa (0.75 of peak)");
+}
