@@ -8,7 +8,7 @@
 #include "lab/ae_report.hpp"
 #include "lab/frame_snapshot.hpp"
 #include "lab/protocol_table.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 #include "materials/genesis.hpp"
 #include "viz/svg_plots.hpp"
 #include "viz/svg_png.hpp"

@@ -3,7 +3,7 @@
 #include "io/json_input.hpp"
 #include "io/results.hpp"
 #include "lab/protocol_table.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 #include <filesystem>
 #include <fstream>

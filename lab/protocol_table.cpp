@@ -1,7 +1,7 @@
 #include "lab/protocol_table.hpp"
 
 #include "io/json_input.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 namespace rocklab {
 

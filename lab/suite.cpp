@@ -5,7 +5,7 @@
 #include "io/results.hpp"
 #include "lab/protocol.hpp"
 #include "lab/protocol_table.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 #include "lab/suite_jobs.hpp"
 #include "materials/genesis.hpp"
 #include "materials/material_card.hpp"

@@ -3,7 +3,7 @@
 // at a platen.
 #include "lab/protocol_table.hpp"
 #include "lab/protocols/brazilian.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 #include <gtest/gtest.h>
 

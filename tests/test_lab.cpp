@@ -11,7 +11,7 @@
 #include "lab/frame_run.hpp"
 #include "lab/protocol_table.hpp"
 #include "lab/protocols/brazilian.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 #include "lab/suite.hpp"
 #include "lab/suite_jobs.hpp"
 #include "viz/svg_png.hpp"

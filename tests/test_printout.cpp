@@ -3,7 +3,7 @@
 // and calibration targets. Results are synthetic JSON, as results.json has them.
 #include "lab/calibration/calibration_file.hpp"
 #include "lab/protocol_table.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 #include "lab/suite.hpp"
 
 #include <gtest/gtest.h>

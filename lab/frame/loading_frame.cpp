@@ -4,7 +4,7 @@
 
 #include "io/json_fields.hpp"
 #include "io/results.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 // The protocol turns them into the test's strain and stresses.
 #include "lab/frame/loading_frame.hpp"
 
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 #include <cmath>
 

@@ -4,7 +4,7 @@
 #include "lab/frame/loading_frame.hpp"
 
 #include "io/json_input.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 #include <algorithm>
 #include <cmath>

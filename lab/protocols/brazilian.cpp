@@ -11,7 +11,7 @@
 // load fell without a split has been pressed stop.travel_multiple times the platen travel to its
 // peak (crushed at the platens) (docs/protocol-format.md).
 #include "lab/protocols/brazilian.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"

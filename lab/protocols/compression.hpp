@@ -5,7 +5,7 @@
 #pragma once
 
 #include "lab/frame/curve_analysis.hpp"
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 namespace rocklab {
 

@@ -1,7 +1,7 @@
 // Direct tension: grips hold the grains near both ends of the specimen and pull them apart at a
 // constant rate; the tensile strength is the peak force over the initial section
 // (docs/protocol-format.md).
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"

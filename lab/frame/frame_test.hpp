@@ -2,7 +2,8 @@
 // protocol keys, the fixtures it mounts, what its readings mean, when it ends, what it reports,
 // prints and plots, and which material properties it gives suites and calibrations. One file per
 // test under lab/protocols/, one row in lab/protocol_table.cpp; the frame (lab/frame/) and the
-// run loop (lab/frame_run.cpp) do the rest. Units SI.
+// run loop (lab/frame_run.cpp) do the rest. The interface lives with the frame that calls it, so
+// the tests depend on the frame and not the other way round. Units SI.
 #pragma once
 
 #include "io/results.hpp"

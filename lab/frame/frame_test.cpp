@@ -1,6 +1,6 @@
 // The defaults of a test in the loading frame: flat platens, not a disk, the standard post-peak
 // stop rule, each declared suite property as gathered; the printout's tensile-strength line.
-#include "lab/protocols/frame_protocol.hpp"
+#include "lab/frame/frame_test.hpp"
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"
