@@ -2,8 +2,8 @@
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"
-#include "lab/protocol_table.hpp"
 #include "lab/frame/frame_test.hpp"
+#include "lab/protocol_table.hpp"
 
 #include <filesystem>
 #include <fstream>

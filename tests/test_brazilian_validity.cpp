@@ -1,9 +1,9 @@
 // The Brazilian disk's validity (ISRM): where its fracture started, from its crack records
 // (lab/protocols/brazilian_validity.cpp), on a disk split from the centre and on disks that failed
 // at a platen.
+#include "lab/frame/frame_test.hpp"
 #include "lab/protocol_table.hpp"
 #include "lab/protocols/brazilian.hpp"
-#include "lab/frame/frame_test.hpp"
 
 #include <gtest/gtest.h>
 

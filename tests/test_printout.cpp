@@ -2,8 +2,8 @@
 // printout and plot know no test by name; the suite properties they declare are the summary keys
 // and calibration targets. Results are synthetic JSON, as results.json has them.
 #include "lab/calibration/calibration_file.hpp"
-#include "lab/protocol_table.hpp"
 #include "lab/frame/frame_test.hpp"
+#include "lab/protocol_table.hpp"
 #include "lab/suite.hpp"
 
 #include <gtest/gtest.h>

@@ -3,9 +3,9 @@
 #include "io/input_error.hpp"
 #include "io/json_input.hpp"
 #include "io/results.hpp"
+#include "lab/frame/frame_test.hpp"
 #include "lab/protocol.hpp"
 #include "lab/protocol_table.hpp"
-#include "lab/frame/frame_test.hpp"
 #include "materials/material_card.hpp"
 
 #include <algorithm>
