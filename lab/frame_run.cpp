@@ -398,13 +398,11 @@ LabSummary run_lab_test(const Protocol& p, const LabOptions& o) {
   return run_frame_test(*p.frame_test, p, o); // the test that read the protocol's options
 }
 
-LabSummary FrameTest::run(const nlohmann::json& j, const std::string& file, const LabOptions& o) {
+LabSummary FrameTest::run(const nlohmann::json&, const std::string& file, const LabOptions& o) {
   // One test object per run: this one reads the protocol's options, runs and prints (a second
   // one made from the file again used to run it).
-  Protocol p = protocol_from_json(j, file, "",
-                                  std::shared_ptr<FrameTest>(std::shared_ptr<FrameTest>(), this));
-  p.text_hash = text_hash(read_input_text(file));
-  return run_lab_test(p, o);
+  return run_lab_test(
+      load_protocol(file, std::shared_ptr<FrameTest>(std::shared_ptr<FrameTest>(), this)), o);
 }
 
 void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {

@@ -154,9 +154,9 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
   return p;
 }
 
-Protocol load_protocol(const std::string& path) {
+Protocol load_protocol(const std::string& path, std::shared_ptr<FrameTest> test) {
   const nlohmann::json j = read_json_file(path);
-  Protocol p = protocol_from_json(j, path, "");
+  Protocol p = protocol_from_json(j, path, "", std::move(test));
   p.text_hash = text_hash(read_input_text(path));
   return p;
 }

@@ -66,7 +66,8 @@ struct Protocol {
 
 /// Read and validate a protocol file of a test in the loading frame; errors name the file, key,
 /// value and allowed range.
-Protocol load_protocol(const std::string& path);
+/// `test`: as for protocol_from_json.
+Protocol load_protocol(const std::string& path, std::shared_ptr<FrameTest> test = nullptr);
 /// Read a protocol from JSON (suites embed them); `file` locates relative paths and errors.
 /// `test`: the test object that reads the protocol's options and runs it (one of the protocol's
 /// "test" kind; null: made here).

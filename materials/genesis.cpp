@@ -50,7 +50,7 @@ nlohmann::json GenesisReport::contact_counts() const {
   for_each_model([&]<class M>() {
     if constexpr (BondsCards<M>)
       for (const std::string_view what : M::card_counts) {
-        const std::string key = std::string(M::name) + "_" + std::string(what);
+        const std::string key = bond_key(M::name, what);
         c[key] = bonded(key);
       }
   });

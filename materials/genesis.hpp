@@ -10,6 +10,8 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
 
 namespace rocklab {
 
@@ -21,6 +23,10 @@ struct GenesisReport {
   /// Bond candidates by what they became: "<model>_<count>" (e.g. "flatjoint_slit", the card's
   /// bonded model's card_counts); bonds(key) reads 0 for one never made.
   std::map<std::string, std::int64_t> bonds;
+  /// The key of `bonds`: "<model>_<count>" (e.g. "flatjoint_slit").
+  static std::string bond_key(std::string_view model, std::string_view count) {
+    return std::string(model) + "_" + std::string(count);
+  }
   std::int64_t bonded(const std::string& key) const {
     const auto it = bonds.find(key);
     return it == bonds.end() ? 0 : it->second;

@@ -71,6 +71,12 @@ def run(cmd, log):
         return subprocess.call(cmd, stdout=out, stderr=subprocess.STDOUT)
 
 
+def card_value(text):
+    """A setting or card value as written: an integer stays an integer (the card refuses 1.0 for
+    an integer key such as flatjoint.fj_Nr or installation.stiffness_ramp)."""
+    return int(text) if text.lstrip("-").isdigit() else float(text)
+
+
 def card_for(args, material, setting):
     """With --card-key (a genesis setting, e.g. packing.equilibrium_ratio): a copy of the card
     with that key set, so that each setting has its own specimen; else the card itself."""
@@ -81,7 +87,7 @@ def card_for(args, material, setting):
     node = card
     for k in path:
         node = node.setdefault(k, {})
-    node[last] = int(setting) if setting.lstrip("-").isdigit() else float(setting)
+    node[last] = card_value(setting)
     out = os.path.join(args.out, "cards", "%s_%s.json" % (os.path.basename(material)[:-5],
                                                            setting))
     os.makedirs(os.path.dirname(out), exist_ok=True)

@@ -40,8 +40,7 @@ def parse_trial(text):
         key, _, value = item.rpartition(":")
         if not key:
             sys.exit("trial %s: '%s' is not KEY:VALUE" % (name, item))
-        # An integer key (e.g. flatjoint.fj_Nr) stays an integer: the card refuses 1.0.
-        changes.append((key, int(value) if value.lstrip("-").isdigit() else float(value)))
+        changes.append((key, ps.card_value(value)))
     return name, changes
 
 

@@ -91,7 +91,7 @@ void finalize_contacts(Run& g) {
                                        : Draws(g.rng, k, candidates.size());
       const CardBond b = card.bonding->bond(d, {m.contacts()[ci].gap, r_avg, &card.linear});
       m.replace_contact_model(ci, b.props);
-      ++rep.bonds[std::string(model_name(kind_of(b.props))) + "_" + std::string(b.count)];
+      ++rep.bonds[GenesisReport::bond_key(model_name(kind_of(b.props)), b.count)];
     }
   for (std::size_t ci = 0; ci < m.contacts().size(); ++ci)
     if (!is_bond[ci]) {
