@@ -199,32 +199,6 @@ bool FrameRun::loop() {
   return true;
 }
 
-// The test's own markers, then the crack-initiation and crack-damage stresses on the axial curve
-// where results.json has them.
-std::vector<PlotMarker> crack_markers(const FrameTest& test, const LoadingFrame& f,
-                                      const nlohmann::json& r) {
-  std::vector<PlotMarker> m;
-  test.plot_markers(r, m);
-  if (!r.contains("crack_stresses"))
-    return m;
-  const nlohmann::json& c = r["crack_stresses"];
-  auto add = [&](const char* stress, const char* strain, const char* label) {
-    if (!r[stress].is_number() || !c[strain].is_number())
-      return;
-    const double eps = c[strain].get<double>();
-    for (const LabSample& s : f.samples()) // the axial stress at that point (the deviator's peer)
-      if (s.axial_strain >= eps) {
-        m.push_back({100 * eps, 1e-6 * s.axial_stress, label});
-        return;
-      }
-  };
-  add("crack_initiation_stress_Pa", "crack_initiation_axial_strain", "CI (crack count)");
-  add("crack_initiation_stress_volumetric_Pa", "crack_initiation_volumetric_axial_strain",
-      "CI (crack volumetric strain)");
-  add("crack_damage_stress_Pa", "crack_damage_axial_strain", "CD (volume reversal)");
-  return m;
-}
-
 /// The SVG documents of a test: the stress-strain plot with crack counts, and the crack map of
 /// the final state (made while the model exists; rendered and written after it is freed).
 struct PlotDocuments {
@@ -283,8 +257,10 @@ PlotDocuments plot_documents(const FrameTest& test, const LoadingFrame& f,
       std::string(test.name()) + " test: " + meta.value("material_name", std::string("specimen"));
   Snapshot final = frame_snapshot(f);
   add_fractures(final, f.cracks().cracks(), ev, INFINITY);
+  std::vector<PlotMarker> markers; // the test's own: crack stresses, a disk's strength
+  test.plot_markers(f.samples(), r, markers);
   return {
-      line_plot_svg(title, labels.x, labels.y, "cracks", series, crack_markers(test, f, r)),
+      line_plot_svg(title, labels.x, labels.y, "cracks", series, markers),
       crack_map_svg(final, title + ", cracks at the end", labels.map_axis, f.geometry().diametral),
       magnitude_frequency_svg(ev.events, title + ", magnitude-frequency of the acoustic emission"),
       acoustic_emission_svg(load_curve(f, labels), ev.events, title)};
@@ -407,44 +383,11 @@ LabSummary FrameTest::run(const nlohmann::json&, const std::string& file, const 
 
 void FrameTest::print(const LabSummary& s, const std::string& out_dir) const {
   const nlohmann::json& r = s.results;
-  auto mpa = [&](const char* key) { return json_number(r, key, 0.0) * 1e-6; };
   std::printf("test         %s   material %s   grains %lld   steps %lld\n",
               r["test"].get<std::string>().c_str(),
               r["provenance"]["material"].get<std::string>().c_str(),
               static_cast<long long>(r["provenance"]["grains"].get<std::int64_t>()),
               static_cast<long long>(r["provenance"]["steps"].get<std::int64_t>()));
-  if (r.contains("peak_stress_Pa")) {
-    std::printf("peak stress  %.4g MPa (deviator %.4g MPa) at axial strain %.4g %%\n",
-                mpa("peak_stress_Pa"), mpa("peak_deviator_Pa"),
-                100 * r["peak_axial_strain"].get<double>());
-    auto shown = [&](const char* key, const char* fmt, double scale) {
-      if (!r.contains(key) || !r[key].is_number())
-        return std::string("not measured");
-      char b[48];
-      std::snprintf(b, sizeof b, fmt, r[key].get<double>() * scale);
-      return std::string(b);
-    };
-    std::printf("E            %s over the linear window, %s secant at 50 %% of peak   poisson %s\n",
-                shown("youngs_modulus_Pa", "%.4g GPa", 1e-9).c_str(),
-                shown("youngs_modulus_secant_Pa", "%.4g GPa", 1e-9).c_str(),
-                shown("poisson_ratio", "%.3f", 1).c_str());
-    // A crack stress no crack marked (no cracks before the peak, a volume still falling) is
-    // null in results.json and "not measured" here, not 0 MPa.
-    auto stress_and_ratio = [&](const char* key, const char* ratio_key) {
-      const std::string s = shown(key, "%.4g MPa", 1e-6);
-      const auto& c = r["crack_stresses"];
-      if (!c.contains(ratio_key) || !c[ratio_key].is_number())
-        return s;
-      char b[32];
-      std::snprintf(b, sizeof b, " (%.2f of peak)", c[ratio_key].get<double>());
-      return s + b;
-    };
-    if (r.contains("crack_stresses"))
-      std::printf("crack stress initiation %s, volumetric %s; damage %s\n",
-                  stress_and_ratio("crack_initiation_stress_Pa", "crack_initiation_ratio").c_str(),
-                  shown("crack_initiation_stress_volumetric_Pa", "%.4g MPa", 1e-6).c_str(),
-                  stress_and_ratio("crack_damage_stress_Pa", "crack_damage_ratio").c_str());
-  }
   print_results(r);
   const auto& c = r["cracks"];
   std::printf("cracks       %lld tension, %lld shear (%lld at peak)\n",

@@ -3,7 +3,7 @@
 // answers, and the 20 x 40 mm granite UCS that once reported nu = 1.31.
 #include "helpers.hpp"
 
-#include "lab/frame/curve_analysis.hpp"
+#include "lab/protocols/curve_analysis.hpp"
 
 #include <cmath>
 #include <filesystem>

@@ -37,7 +37,7 @@ TEST(Printout, ABrazilianTestPrintsAndMarksItsStrengthBeforeTheSplit) {
   EXPECT_EQ(printed(*t, r), "tensile strength 8.5 MPa (force 1234 N) before the split released the "
                             "diametral tension; the halves then carried up to 9.75 MPa\n");
   std::vector<PlotMarker> m;
-  t->plot_markers(r, m);
+  t->plot_markers({}, r, m);
   ASSERT_EQ(m.size(), 1u);
   EXPECT_DOUBLE_EQ(m[0].x, 0.2);
   EXPECT_DOUBLE_EQ(m[0].y, 8.5);
@@ -48,7 +48,7 @@ TEST(Printout, ABrazilianTestPrintsAndMarksItsStrengthBeforeTheSplit) {
   r["tensile_strength_Pa"] = 9.75e6;
   EXPECT_EQ(printed(*t, r), "tensile strength 9.75 MPa (force 1234 N)\n");
   m.clear();
-  t->plot_markers(r, m);
+  t->plot_markers({}, r, m);
   EXPECT_TRUE(m.empty());
   // No split: no strength.
   r["tensile_strength_Pa"] = nullptr;
@@ -61,19 +61,57 @@ TEST(Printout, ABrazilianTestPrintsAndMarksItsStrengthBeforeTheSplit) {
 }
 
 TEST(Printout, TriaxialPrintsItsConfinementAndTheOthersTheirOwnLinesOnly) {
-  const json confined = {{"confinement_Pa", 5e6},
-                         {"confinement_measured_Pa", {{"min", 4.9e6}, {"max", 5.1e6}}}};
+  // The compression tests print the peak, E and nu (the block the generic printout used to print
+  // for any test), a triaxial its confinement band after them; a tension test its strength only.
+  const json peak = {{"peak_stress_Pa", 2e8},
+                     {"peak_deviator_Pa", 1.95e8},
+                     {"peak_axial_strain", 0.003},
+                     {"youngs_modulus_Pa", 7e10},
+                     {"poisson_ratio", 0.25}};
+  json confined = peak;
+  confined["confinement_Pa"] = 5e6;
+  confined["confinement_measured_Pa"] = {{"min", 4.9e6}, {"max", 5.1e6}};
+  const std::string block = "peak stress  200 MPa (deviator 195 MPa) at axial strain 0.3 %\n"
+                            "E            70 GPa over the linear window, not measured secant at "
+                            "50 % of peak   poisson 0.250\n";
   EXPECT_EQ(printed(*make_frame_test("triaxial"), confined),
-            "confinement  5 MPa (held between 4.9 and 5.1 MPa)\n");
-  EXPECT_EQ(printed(*make_frame_test("ucs"), {{"confinement_Pa", 0.0}}), "");
+            block + "confinement  5 MPa (held between 4.9 and 5.1 MPa)\n");
+  json unconfined = peak;
+  unconfined["confinement_Pa"] = 0.0;
+  EXPECT_EQ(printed(*make_frame_test("ucs"), unconfined), block);
   EXPECT_EQ(printed(*make_frame_test("direct_tension"),
                     {{"tensile_strength_Pa", 3e6}, {"peak_force_N", 50.0}}),
             "tensile strength 3 MPa (force 50 N)\n");
   for (const char* name : {"ucs", "triaxial", "direct_tension"}) {
     std::vector<PlotMarker> m;
-    make_frame_test(name)->plot_markers(confined, m);
+    make_frame_test(name)->plot_markers({}, confined, m);
     EXPECT_TRUE(m.empty()) << name;
   }
+}
+
+TEST(Printout, ACompressionTestMarksItsCrackStressesOnTheAxialCurve) {
+  // The crack stresses are the compression test's markers, placed at the axial stress of the
+  // first reading at their strain (the generic plot code placed them before).
+  std::vector<LabSample> samples(3);
+  for (int k = 0; k < 3; ++k) {
+    samples[k].axial_strain = 0.001 * (k + 1);
+    samples[k].axial_stress = 5e7 * (k + 1);
+  }
+  const json r = {{"crack_initiation_stress_Pa", 9e7},
+                  {"crack_initiation_stress_volumetric_Pa", nullptr},
+                  {"crack_damage_stress_Pa", 1.4e8},
+                  {"crack_stresses",
+                   {{"crack_initiation_axial_strain", 0.0015},
+                    {"crack_initiation_volumetric_axial_strain", nullptr},
+                    {"crack_damage_axial_strain", 0.003}}}};
+  std::vector<PlotMarker> m;
+  make_frame_test("ucs")->plot_markers(samples, r, m);
+  ASSERT_EQ(m.size(), 2u);
+  EXPECT_DOUBLE_EQ(m[0].x, 0.15);
+  EXPECT_DOUBLE_EQ(m[0].y, 100);
+  EXPECT_EQ(m[0].label, "CI (crack count)");
+  EXPECT_DOUBLE_EQ(m[1].y, 150);
+  EXPECT_EQ(m[1].label, "CD (volume reversal)");
 }
 
 TEST(Printout, EveryDeclaredSuitePropertyIsASummaryKeyAndACalibrationTarget) {

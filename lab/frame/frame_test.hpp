@@ -82,10 +82,13 @@ public:
   /// The test's own results (the frame writes the common ones).
   virtual void results(const LoadingFrame& f, nlohmann::json& r) const = 0;
   virtual PlotLabels plot_labels() const = 0;
-  /// The test's own lines of the printout, after the common ones on the peak (default: none).
+  /// The test's own lines of the printout, after the first (test, material, grains, steps) and
+  /// before the crack counts (default: none).
   virtual void print_results(const nlohmann::json& /*r*/) const {}
-  /// The test's own markers on the stress-strain plot, before the crack stresses' (default: none).
-  virtual void plot_markers(const nlohmann::json& /*r*/, std::vector<PlotMarker>& /*m*/) const {}
+  /// The test's own markers on the stress-strain plot (`samples`: the run's fine readings;
+  /// default: none).
+  virtual void plot_markers(const std::vector<LabSample>& /*samples*/, const nlohmann::json& /*r*/,
+                            std::vector<PlotMarker>& /*m*/) const {}
   /// The material properties this test gives suites and calibrations (default: none).
   virtual std::vector<SuiteProperty> suite_properties() const { return {}; }
   /// Add this test's results.json to a suite's values (default: nothing).

@@ -334,7 +334,8 @@ public:
     v.values["brazilian_valid"] = k / (n + 1);
   }
   // The tensile strength where it is not the peak (taken before the split).
-  void plot_markers(const nlohmann::json& r, std::vector<PlotMarker>& m) const override {
+  void plot_markers(const std::vector<LabSample>&, const nlohmann::json& r,
+                    std::vector<PlotMarker>& m) const override {
     if (!r.contains("split"))
       return;
     const nlohmann::json& split = r["split"];

@@ -4,8 +4,8 @@
 // lateral strain. Units SI.
 #pragma once
 
-#include "lab/frame/curve_analysis.hpp"
 #include "lab/frame/frame_test.hpp"
+#include "lab/protocols/curve_analysis.hpp"
 
 namespace rocklab {
 
@@ -17,7 +17,11 @@ public:
   void stresses(const LoadingFrame& f, LabSample& s) const override;
   void results(const LoadingFrame& f, nlohmann::json& r) const override;
   PlotLabels plot_labels() const override;
+  /// The peak, the elastic constants and the crack stresses, then the confinement band.
   void print_results(const nlohmann::json& r) const override;
+  /// The crack-initiation and crack-damage stresses on the axial curve.
+  void plot_markers(const std::vector<LabSample>& samples, const nlohmann::json& r,
+                    std::vector<PlotMarker>& m) const override;
   /// A point (confinement, peak stress) of the strength envelope.
   void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override;
 

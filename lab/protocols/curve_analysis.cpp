@@ -1,4 +1,4 @@
-#include "lab/frame/curve_analysis.hpp"
+#include "lab/protocols/curve_analysis.hpp"
 
 #include "lab/frame/elastic_fit.hpp"
 
