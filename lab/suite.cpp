@@ -209,21 +209,33 @@ std::vector<Job> SuiteRun::run_tests(const std::map<std::string, std::string>& s
   return jobs;
 }
 
-// The headline properties, in the order rock engineers read them (E, nu, strengths, envelope):
-// summary.csv and the printed table show them first, then every other property a test declares
-// (table order).
-constexpr const char* kHeadline[] = {
-    "youngs_modulus_Pa", "poisson_ratio",      "ucs_Pa",      "bts_Pa",       "direct_tension_Pa",
-    "ucs_over_bts",      "friction_angle_deg", "cohesion_Pa", "hoek_brown_mi"};
+// The per-test columns of tests.csv, summary.json's test rows and the printed table: every
+// results.json key a frame test declares for them, in table order, each once.
+const std::vector<SuiteProperty>& test_columns() {
+  static const std::vector<SuiteProperty> cols = [] {
+    std::vector<SuiteProperty> out;
+    for (const std::string& test : frame_test_names())
+      for (const SuiteProperty& c : make_frame_test(test)->result_columns())
+        if (std::none_of(out.begin(), out.end(),
+                         [&](const SuiteProperty& o) { return std::string(o.name) == c.name; }))
+          out.push_back(c);
+    return out;
+  }();
+  return cols;
+}
 
-// Every property the frame tests declare, in table order, each once.
-std::vector<std::string> declared_properties() {
-  std::vector<std::string> names;
-  for (const std::string& test : frame_test_names())
-    for (const SuiteProperty& p : make_frame_test(test)->suite_properties())
-      if (std::find(names.begin(), names.end(), p.name) == names.end())
-        names.emplace_back(p.name);
-  return names;
+// The declared properties in the order a suite shows them: the headline ones by their place, then
+// the others in table order.
+std::vector<SuiteProperty> shown_properties() {
+  std::vector<SuiteProperty> out;
+  for (const DeclaredProperty& d : declared_properties())
+    out.push_back(d.p);
+  std::stable_sort(out.begin(), out.end(), [](const SuiteProperty& a, const SuiteProperty& b) {
+    const int ka = a.headline > 0 ? a.headline : 1 << 20,
+              kb = b.headline > 0 ? b.headline : 1 << 20;
+    return ka < kb;
+  });
+  return out;
 }
 
 // 3. The summary of the tests' results.
@@ -232,13 +244,19 @@ struct SuiteSummary {
   SuiteValues values; ///< what each test's results gave (the tests' own add_to_suite)
   nlohmann::json warnings = nlohmann::json::array(); ///< every test's, as "NAME: what"
   bool failed = false;
-  std::string csv = "name,test,status,confinement_Pa,youngs_modulus_Pa,poisson_ratio,"
-                    "peak_stress_Pa,peak_deviator_Pa,tensile_strength_Pa,cracks_tension,"
-                    "cracks_shear,grains,steps,wall_time_s\n";
+  std::string csv = csv_header();
 
   void add(const SuiteTest& t, const Job& j, OutputDir& out);
   nlohmann::json properties() const;
+  static std::string csv_header();
 };
+
+std::string SuiteSummary::csv_header() {
+  std::string h = "name,test,status";
+  for (const SuiteProperty& c : test_columns())
+    h.append(",").append(c.name);
+  return h + ",cracks_tension,cracks_shear,grains,steps,wall_time_s\n";
+}
 
 void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
   // Move the test's output folder up: tests/NAME/{protocol.json, results.json, ...}.
@@ -250,8 +268,8 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
     row["exit_status"] = j.status;
     row["error"] = last_lines(j.log, 3);
     tests.push_back(row);
-    csv += t.name + "," + row["test"].get<std::string>() + ",failed,,,,,,,,,,," +
-           format_double(j.seconds) + "\n";
+    csv += t.name + "," + row["test"].get<std::string>() + ",failed" +
+           std::string(test_columns().size() + 4, ',') + "," + format_double(j.seconds) + "\n";
     return;
   }
   for (const auto& entry : fs::directory_iterator(dir / "out"))
@@ -260,11 +278,8 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
   const nlohmann::json r = read_json_file((dir / "results.json").string(), Nulls::Allow);
   row["status"] = "ok";
   row["results"] = "tests/" + t.name + "/results.json";
-  const double conf = num(r, "confinement_Pa");
-  row["confinement_Pa"] = number_or_null(conf);
-  for (const char* key : {"youngs_modulus_Pa", "poisson_ratio", "peak_stress_Pa",
-                          "peak_deviator_Pa", "tensile_strength_Pa"})
-    row[key] = number_or_null(num(r, key));
+  for (const SuiteProperty& c : test_columns())
+    row[c.name] = number_or_null(num(r, c.name));
   row["cracks"] = r["cracks"];
   if (r.contains("warnings")) {
     row["warnings"] = r["warnings"];
@@ -277,15 +292,14 @@ void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
   const std::string type = r.value("test", "");
   if (const std::unique_ptr<FrameTest> test = make_frame_test(type))
     test->add_to_suite(r, values);
-  auto f = [&](const char* key) {
-    const double v = num(r, key);
-    return std::isfinite(v) ? format_double(v) : std::string();
-  };
-  csv += t.name + "," + type + ",ok," + f("confinement_Pa") + "," + f("youngs_modulus_Pa") + "," +
-         f("poisson_ratio") + "," + f("peak_stress_Pa") + "," + f("peak_deviator_Pa") + "," +
-         f("tensile_strength_Pa") + "," + r["cracks"]["tension"].dump() + "," +
-         r["cracks"]["shear"].dump() + "," + r["provenance"]["grains"].dump() + "," +
-         r["provenance"]["steps"].dump() + "," + format_double(j.seconds) + "\n";
+  csv += t.name + "," + type + ",ok";
+  for (const SuiteProperty& c : test_columns()) {
+    const double v = num(r, c.name);
+    csv += "," + (std::isfinite(v) ? format_double(v) : std::string());
+  }
+  csv += "," + r["cracks"]["tension"].dump() + "," + r["cracks"]["shear"].dump() + "," +
+         r["provenance"]["grains"].dump() + "," + r["provenance"]["steps"].dump() + "," +
+         format_double(j.seconds) + "\n";
   tests.push_back(row);
 }
 
@@ -301,10 +315,9 @@ nlohmann::json SuiteSummary::properties() const {
 } // namespace
 
 std::vector<std::string> summary_columns() {
-  std::vector<std::string> cols(std::begin(kHeadline), std::end(kHeadline));
-  for (const std::string& name : declared_properties())
-    if (std::find(cols.begin(), cols.end(), name) == cols.end())
-      cols.push_back(name);
+  std::vector<std::string> cols;
+  for (const SuiteProperty& p : shown_properties())
+    cols.emplace_back(p.name);
   return cols;
 }
 
@@ -323,6 +336,19 @@ void say_genesis_estimates(const std::string& card_file, const std::string& file
       std::fprintf(stderr, "[rocklab %s] %s: genesis %s\n", tag, t.name.c_str(), line.c_str());
   }
 }
+
+namespace {
+
+// How the properties that say so are measured (summary.json "methods").
+nlohmann::json methods() {
+  nlohmann::json m = nlohmann::json::object();
+  for (const DeclaredProperty& d : declared_properties())
+    if (d.p.method)
+      m[d.p.name] = d.p.method;
+  return m;
+}
+
+} // namespace
 
 nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
   using clock = std::chrono::steady_clock;
@@ -349,26 +375,20 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
     sum.add(s.tests[k], jobs[k], out);
   const nlohmann::json props = sum.properties();
   const int parallel = run.parallel, threads = run.threads;
-  nlohmann::json summary{
-      {"suite", s.name},
-      {"suite_file", s.file},
-      {"suite_hash", s.text_hash},
-      {"material", s.material.value("name", "")},
-      {"material_file", s.material_file},
-      {"units", "SI (m, kg, s, N, Pa, J); stresses compression positive"},
-      {"properties", props},
-      {"methods",
-       {{"crack_initiation_over_ucs",
-         "crack volumetric strain (Martin & Chandler 1994), as laboratory cores "
-         "are read; crack_initiation_count_over_ucs: the crack count onset"},
-        {"bts_Pa",
-         "the largest load before the disk lost the tension across its loaded diameter"}}},
-      {"warnings", sum.warnings},
-      {"tests", sum.tests},
-      {"parallel_processes", parallel},
-      {"threads_per_process", threads},
-      {"rocklab_version", ROCKLAB_VERSION},
-      {"wall_time_s", std::chrono::duration<double>(clock::now() - t0).count()}};
+  nlohmann::json summary{{"suite", s.name},
+                         {"suite_file", s.file},
+                         {"suite_hash", s.text_hash},
+                         {"material", s.material.value("name", "")},
+                         {"material_file", s.material_file},
+                         {"units", "SI (m, kg, s, N, Pa, J); stresses compression positive"},
+                         {"properties", props},
+                         {"methods", methods()},
+                         {"warnings", sum.warnings},
+                         {"tests", sum.tests},
+                         {"parallel_processes", parallel},
+                         {"threads_per_process", threads},
+                         {"rocklab_version", ROCKLAB_VERSION},
+                         {"wall_time_s", std::chrono::duration<double>(clock::now() - t0).count()}};
   auto cell = [](const nlohmann::json& v) {
     return v.is_number() ? format_double(v.get<double>()) : std::string();
   };
@@ -389,82 +409,74 @@ nlohmann::json run_suite(const Suite& s, const SuiteOptions& o) {
   return summary;
 }
 
-std::string summary_table(const nlohmann::json& sm) {
-  std::string t;
-  char line[256];
-  std::snprintf(line, sizeof line, "suite %s   material %s\n",
-                sm["suite"].get<std::string>().c_str(), sm["material"].get<std::string>().c_str());
-  t += line;
-  t += "test                 type            conf [MPa]  E [GPa]   nu     peak [MPa]  tensile "
-       "[MPa]  cracks  time [s]\n";
-  auto mpa = [](const nlohmann::json& v, double scale) {
-    char b[32];
-    if (v.is_number())
-      std::snprintf(b, sizeof b, "%.4g", v.get<double>() * scale);
-    else
-      std::snprintf(b, sizeof b, "-");
-    return std::string(b);
-  };
+namespace {
+
+// `items` joined by three spaces, in lines of at most about 100 columns.
+std::string wrapped(const std::vector<std::string>& items) {
+  std::string out, line;
+  for (const std::string& item : items) {
+    if (!line.empty() && line.size() + 3 + item.size() > 100) {
+      out += line + "\n";
+      line.clear();
+    }
+    line += (line.empty() ? "" : "   ") + item;
+  }
+  return line.empty() ? out : out + line + "\n";
+}
+
+// The per-test table: one row per test, a column per declared result key.
+std::string tests_table(const nlohmann::json& sm) {
+  std::vector<std::string> head{"test", "type"};
+  for (const SuiteProperty& c : test_columns()) {
+    const std::string unit = display_unit(c.kind);
+    head.push_back(std::string(c.label ? c.label : c.name) +
+                   (unit.empty() ? "" : " [" + unit + "]"));
+  }
+  head.insert(head.end(), {"cracks", "time [s]"});
+  std::vector<std::vector<std::string>> rows{head};
   for (const auto& r : sm["tests"]) {
+    std::vector<std::string> row{r["name"].get<std::string>(), r["test"].get<std::string>()};
     if (r["status"] != "ok") {
-      std::snprintf(line, sizeof line, "%-20s %-15s FAILED (see logs/%s.log)\n",
-                    r["name"].get<std::string>().c_str(), r["test"].get<std::string>().c_str(),
-                    r["name"].get<std::string>().c_str());
-      t += line;
+      row.push_back("FAILED (see logs/" + row[0] + ".log)");
+      rows.push_back(row);
       continue;
     }
-    std::snprintf(line, sizeof line, "%-20s %-15s %-11s %-9s %-6s %-11s %-13s %-7lld %.1f\n",
-                  r["name"].get<std::string>().c_str(), r["test"].get<std::string>().c_str(),
-                  mpa(r["confinement_Pa"], 1e-6).c_str(), mpa(r["youngs_modulus_Pa"], 1e-9).c_str(),
-                  mpa(r["poisson_ratio"], 1).c_str(), mpa(r["peak_stress_Pa"], 1e-6).c_str(),
-                  mpa(r["tensile_strength_Pa"], 1e-6).c_str(),
-                  static_cast<long long>(r["cracks"]["total"].get<std::int64_t>()),
-                  r["wall_time_s"].get<double>());
-    t += line;
+    for (const SuiteProperty& c : test_columns()) {
+      const std::string v = format_property(r.value(c.name, nlohmann::json()), c.kind);
+      const std::string unit = display_unit(c.kind);
+      row.push_back(v == "-" || unit.empty() ? v : v.substr(0, v.size() - unit.size() - 1));
+    }
+    char b[48];
+    std::snprintf(b, sizeof b, "%.1f", r["wall_time_s"].get<double>());
+    row.insert(row.end(), {r["cracks"]["total"].dump(), b});
+    rows.push_back(row);
   }
-  const auto& p = sm["properties"];
-  // A BTS only from valid disks: where every disk failed at a platen it is not measured, and
-  // what those disks read is said as such.
-  std::string bts = "BTS " + mpa(p["bts_Pa"], 1e-6) + " MPa";
-  if (!p.value("bts_Pa", nlohmann::json()).is_number() &&
-      p.value("bts_not_valid_Pa", nlohmann::json()).is_number())
-    bts = "BTS not measured (no valid disk; the disks not valid read " +
-          mpa(p["bts_not_valid_Pa"], 1e-6) + " MPa)";
-  std::snprintf(line, sizeof line,
-                "E %s GPa   nu %s   UCS %s MPa   %s   direct tension %s MPa   UCS/BTS %s\n",
-                mpa(p["youngs_modulus_Pa"], 1e-9).c_str(), mpa(p["poisson_ratio"], 1).c_str(),
-                mpa(p["ucs_Pa"], 1e-6).c_str(), bts.c_str(),
-                mpa(p["direct_tension_Pa"], 1e-6).c_str(), mpa(p["ucs_over_bts"], 1).c_str());
-  t += line;
-  // The envelope line only where compression peaks at two confinements or more gave one; a
-  // suite without triaxial tests says so instead of a row of dashes.
-  const int envelope_points = p.value("envelope_points", 0);
-  if (envelope_points < 2)
-    std::snprintf(line, sizeof line,
-                  "Envelope: none (%d compression peak%s; Mohr-Coulomb needs 2 confinements, "
-                  "Hoek-Brown 3)\n",
-                  envelope_points, envelope_points == 1 ? "" : "s");
-  else
-    std::snprintf(line, sizeof line,
-                  "Mohr-Coulomb: friction angle %s deg, cohesion %s MPa (R2 %s)   Hoek-Brown m_i "
-                  "%s (%d points, sigma3 up to %s UCS, fit error %s)\n",
-                  mpa(p["friction_angle_deg"], 1).c_str(), mpa(p["cohesion_Pa"], 1e-6).c_str(),
-                  mpa(p["mohr_coulomb_r2"], 1).c_str(), mpa(p["hoek_brown_mi"], 1).c_str(),
-                  envelope_points,
-                  mpa(p.value("envelope_sigma3_max_over_ucs", nlohmann::json()), 1).c_str(),
-                  mpa(p.value("hoek_brown_fit_error", nlohmann::json()), 1).c_str());
-  t += line;
-  // Every other property a test declares (a new test's shows here without editing this table).
-  const std::set<std::string> printed(std::begin(kHeadline), std::end(kHeadline));
-  std::string more;
-  for (const std::string& name : declared_properties())
-    if (!printed.count(name))
-      more.append(more.empty() ? "" : "   ")
-          .append(name)
-          .append(" ")
-          .append(mpa(p.value(name, nlohmann::json()), 1));
-  if (!more.empty())
-    t += more + "\n";
+  std::vector<std::size_t> width(head.size(), 0);
+  for (const auto& row : rows) // a failed test's row runs on in its third column
+    for (std::size_t k = 0; k < row.size() && row.size() == head.size(); ++k)
+      width[k] = std::max(width[k], row[k].size());
+  std::string t;
+  for (const auto& row : rows) {
+    std::string line;
+    for (std::size_t k = 0; k < row.size(); ++k)
+      line += k + 1 < row.size() ? row[k] + std::string(width[k] + 2 - row[k].size(), ' ') : row[k];
+    t += line + "\n";
+  }
+  return t;
+}
+
+} // namespace
+
+std::string summary_table(const nlohmann::json& sm) {
+  std::string t = "suite " + sm["suite"].get<std::string>() + "   material " +
+                  sm["material"].get<std::string>() + "\n" + tests_table(sm);
+  // The headline properties first, then every other property a test declares (a new test's
+  // shows here without editing this table); each says what it lacks where it was not measured.
+  const nlohmann::json& p = sm["properties"];
+  std::vector<std::string> headline, more;
+  for (const SuiteProperty& d : shown_properties())
+    (d.headline > 0 ? headline : more).push_back(property_text(d, p));
+  t += wrapped(headline) + wrapped(more);
   for (const auto& w : sm.value("warnings", nlohmann::json::array()))
     t += "warning: " + w.get<std::string>() + "\n";
   return t;

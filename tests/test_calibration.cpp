@@ -24,6 +24,11 @@
 
 using namespace rocklab::calibration;
 
+// The properties the stages steer, by the roles their tests declare (lab/protocols/ucs.cpp).
+constexpr const char* kYoungs = "youngs_modulus_Pa";
+constexpr const char* kPoisson = "poisson_ratio";
+constexpr const char* kUcs = "ucs_Pa";
+
 namespace {
 
 // Parameters: 0 modulus [Pa], 1 stiffness ratio, 2 tensile strength [Pa] (cohesion = r x it),

@@ -138,24 +138,29 @@ TEST(Printout, EveryDeclaredSuitePropertyIsASummaryKeyAndACalibrationTarget) {
 
 TEST(Printout, EveryDeclaredSuitePropertyIsAColumnOfTheSuiteTables) {
   // summary.csv and the printed suite table list a property a test declares without an edit of
-  // their own: the headline first, then the others.
+  // their own: the headline first (by their declared place), then the others; each printed with
+  // its label and in its kind's unit.
   const std::vector<std::string> cols = summary_columns();
   ASSERT_GE(cols.size(), 9u);
   EXPECT_EQ(cols[0], "youngs_modulus_Pa");
+  EXPECT_EQ(cols[2], "ucs_Pa");
   EXPECT_EQ(cols[8], "hoek_brown_mi");
   json props = {{"envelope_points", 3}, {"mohr_coulomb_r2", 0.99}};
-  for (const std::string& name : frame_test_names())
-    for (const SuiteProperty& p : make_frame_test(name)->suite_properties()) {
-      EXPECT_NE(std::find(cols.begin(), cols.end(), p.name), cols.end()) << p.name;
-      props[p.name] = 1.5;
-    }
+  for (const DeclaredProperty& d : declared_properties()) {
+    EXPECT_NE(std::find(cols.begin(), cols.end(), d.p.name), cols.end()) << d.p.name;
+    EXPECT_TRUE(d.p.label) << d.p.name << ": every declared property has a label";
+    props[d.p.name] = 1.5;
+  }
   const json summary = {
       {"suite", "s"}, {"material", "m"}, {"tests", json::array()}, {"properties", props}};
   const std::string table = summary_table(summary);
-  for (std::size_t k = 9; k < cols.size(); ++k)
-    EXPECT_NE(table.find(cols[k] + " 1.5"), std::string::npos) << cols[k] << "\n" << table;
-  EXPECT_NE(table.find("E 1.5e-09 GPa"), std::string::npos) << table;
-  EXPECT_NE(table.find("BTS 1.5e-06 MPa"), std::string::npos) << table;
+  for (const DeclaredProperty& d : declared_properties())
+    EXPECT_NE(table.find(property_text(d.p, props)), std::string::npos) << d.p.name << "\n"
+                                                                        << table;
+  EXPECT_NE(table.find("E 1.5e-09 GPa   nu 1.5   UCS 1.5e-06 MPa   BTS 1.5e-06 MPa"),
+            std::string::npos)
+      << table;
+  EXPECT_NE(table.find("CI/UCS 1.5"), std::string::npos) << table;
   // No valid disk: the BTS is not measured, and what the disks that were not valid read is said as
   // such, not as the BTS.
   json invalid = summary;
@@ -172,19 +177,41 @@ TEST(Printout, EveryDeclaredSuitePropertyIsAColumnOfTheSuiteTables) {
   json fitted = summary;
   fitted["properties"]["envelope_sigma3_max_over_ucs"] = 0.25;
   fitted["properties"]["hoek_brown_fit_error"] = 0.156;
-  EXPECT_NE(
-      summary_table(fitted).find("m_i 1.5 (3 points, sigma3 up to 0.25 UCS, fit error 0.156)"),
-      std::string::npos)
+  EXPECT_NE(summary_table(fitted).find(
+                "Hoek-Brown m_i 1.5 (3 points, sigma3 up to 0.25 UCS, fit error 0.156)"),
+            std::string::npos)
       << summary_table(fitted);
-  // A suite without triaxial tests has no envelope: one line says so, not a row of dashes.
+  // A suite without triaxial tests has no envelope: its properties say why, not a row of dashes.
   json bare = summary;
   bare["properties"]["envelope_points"] = 1;
+  for (const char* k : {"friction_angle_deg", "cohesion_Pa", "hoek_brown_mi"})
+    bare["properties"][k] = nullptr;
   const std::string none = summary_table(bare);
-  EXPECT_NE(none.find("Envelope: none (1 compression peak; Mohr-Coulomb needs 2 confinements, "
-                      "Hoek-Brown 3)"),
+  EXPECT_NE(none.find("friction angle not measured (1 compression peak(s); Mohr-Coulomb needs 2 "
+                      "confinements)"),
             std::string::npos)
       << none;
-  EXPECT_EQ(none.find("Hoek-Brown m_i"), std::string::npos) << none;
+  EXPECT_NE(none.find("Hoek-Brown m_i not measured (1 compression peak(s); Hoek-Brown needs 3)"),
+            std::string::npos)
+      << none;
+}
+
+TEST(Printout, ATestsColumnsAreItsDeclaredResultKeys) {
+  // tests.csv's header and the printed per-test table come from the tests' result columns.
+  const json row = {{"name", "disk"},
+                    {"test", "brazilian"},
+                    {"status", "ok"},
+                    {"tensile_strength_Pa", 9.3e6},
+                    {"cracks", {{"total", 42}}},
+                    {"wall_time_s", 12.34}};
+  const json summary = {
+      {"suite", "s"}, {"material", "m"}, {"tests", {row}}, {"properties", json::object()}};
+  const std::string t = summary_table(summary);
+  EXPECT_NE(t.find("tensile [MPa]"), std::string::npos) << t;
+  EXPECT_NE(t.find("9.3 "), std::string::npos) << t;
+  EXPECT_NE(t.find("42"), std::string::npos) << t;
+  EXPECT_NE(t.find("12.3"), std::string::npos) << t;
+  EXPECT_NE(t.find("conf [MPa]"), std::string::npos) << t;
 }
 
 TEST(Printout, ACrackStressNoCrackMarkedReadsNotMeasuredNotZero) {

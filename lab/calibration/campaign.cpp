@@ -6,6 +6,7 @@
 #include "lab/calibration/noise.hpp"
 #include "lab/calibration/report.hpp"
 #include "lab/calibration/rounds.hpp"
+#include "lab/property.hpp"
 #include "viz/svg_png.hpp"
 
 #include <algorithm>
@@ -64,11 +65,9 @@ void print_progress(const std::string& what, const CalibrationFile& c, const Eva
   char tail[64] = "", cpu[48] = "";
   if (unmeasured > 0)
     std::snprintf(tail, sizeof tail, " (%d target(s) not measured)", unmeasured);
-  if (e.rejected_disks > 0) {
-    char r[96];
-    std::snprintf(r, sizeof r, "; %d Brazilian disk(s) not valid (fracture at a platen) left out",
-                  e.rejected_disks);
-    line += r;
+  if (e.rejected_tests > 0) {
+    line += "; " + std::to_string(e.rejected_tests) + " test(s) not valid left out (" +
+            validity_rules() + ")";
   }
   if (e.cpu_utilisation >= 0)
     std::snprintf(cpu, sizeof cpu, ", CPU %.0f %% of %d cores", 100 * e.cpu_utilisation, e.cores);
@@ -94,7 +93,7 @@ ValidationRun validation(Evaluator& ev, const CalibrationFile& c, const std::vec
   const Evaluation e = ev.run_on(values, Stage::Final, v.seeds);
   if (talk)
     print_progress("validation", c, e, std::chrono::steady_clock::now() - t);
-  v.mean = e.mean, v.sd = e.sd, v.se = e.se, v.rejected = e.rejected_disks;
+  v.mean = e.mean, v.sd = e.sd, v.se = e.se, v.rejected = e.rejected_tests;
   return v;
 }
 
@@ -178,7 +177,7 @@ CampaignSummary run_campaign(const std::string& file, const EvaluatorOptions& o)
   r.outcome = &cs.outcome;
   r.sd = last.sd;
   r.se = last.se;
-  r.rejected = last.rejected_disks;
+  r.rejected = last.rejected_tests;
   r.seeds = static_cast<int>(last.folders.size());
   r.final_folders = last.folders;
   std::vector<double> values;
@@ -233,12 +232,9 @@ std::string run_pilot(const std::string& file, const EvaluatorOptions& o) {
   std::snprintf(b, sizeof b, "pilot        the start card on %zu seed(s), every test\n",
                 e.folders.size());
   s += b;
-  if (e.rejected_disks > 0) {
-    std::snprintf(b, sizeof b,
-                  "pilot        %d Brazilian disk(s) not valid (fracture at a platen, ISRM) left "
-                  "out of the means that read the disk\n",
-                  e.rejected_disks);
-    s += b;
+  if (e.rejected_tests > 0) {
+    s += "pilot        " + std::to_string(e.rejected_tests) +
+         " test(s) not valid left out of the means that rest on them (" + validity_rules() + ")\n";
   }
   const Measured scatter = known_scatter(e.sd, e.se);
   for (const Target& t : c.targets) {

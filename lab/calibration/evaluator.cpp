@@ -5,6 +5,7 @@
 #include "io/json_input.hpp"
 #include "io/output_dir.hpp"
 #include "io/results.hpp"
+#include "lab/property.hpp"
 #include "lab/protocol_table.hpp"
 #include "lab/suite.hpp"
 #include "materials/material_card.hpp"
@@ -36,26 +37,25 @@ Evaluator::Evaluator(const CalibrationFile& c, EvaluatorOptions o) : c_(c), o_(s
                                           : (fs::path(o_.out_dir) / "seeds.csv").string());
 }
 
+// Stages 1 and 2 run only the tests that measure what they steer: a test declaring a property
+// with a stage role (lab/property.hpp: the UCS test's E, nu and UCS).
 nlohmann::json Evaluator::tests_of(Stage s) const {
   if (s == Stage::Ratios || s == Stage::Final)
     return c_.tests;
   nlohmann::json out = nlohmann::json::array();
   for (const auto& t : c_.tests)
-    if (t.value("test", "") == "ucs")
+    if (std::ranges::any_of(declared_properties(), [&](const DeclaredProperty& d) {
+          return d.test == t.value("test", "") && d.p.role != CalibrationRole::Reported;
+        }))
       out.push_back(t);
   return out;
 }
 
 namespace {
-// A property measured on (or over) the Brazilian disk, other than its validity.
-bool reads_the_disk(const std::string& property) {
-  if (property == "brazilian_valid" || property == "brazilian_disks")
-    return false;
-  for (const TargetNeed& n : target_needs())
-    if (n.property == property &&
-        (std::string(n.test) == "brazilian" || (n.other && std::string(n.other) == "brazilian")))
-      return true;
-  return false;
+// The share of valid tests a property rests on (lab/property.hpp), nullptr where every test counts.
+const char* valid_share_of(const std::string& property) {
+  const SuiteProperty* d = find_property(property);
+  return d ? d->valid_share : nullptr;
 }
 
 // A finished replicate is reused unless one of its tests rejected its input (exit status 2). That
@@ -286,18 +286,21 @@ Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
       if ((!ranks || ranks->rank() == 0) && own && !rows_.find(reps[i].key))
         rows_.add(reps[i].key, reps[i].seed, props); // a cached folder's row
     }
-    // The share of the seed's disks that were valid, and how many it had (lab/protocols/brazilian).
-    const double valid = json_number(props, "brazilian_valid", 1.0);
-    const bool rejected = valid == 0;
-    ev.rejected_disks +=
-        static_cast<int>(std::lround(json_number(props, "brazilian_disks", 0.0) * (1 - valid)));
-    for (const auto& [k, v] : props.items())
-      all[k].push_back(v.is_number() && !(rejected && reads_the_disk(k)) ? v.get<double>()
-                                                                         : std::nan(""));
+    // The tests of this seed that were not valid (each declared share of valid tests times what
+    // it is a share of); a property resting on a share of 0 is left out of this seed.
+    for (const DeclaredProperty& d : declared_properties())
+      if (d.p.share_of)
+        ev.rejected_tests += static_cast<int>(std::lround(json_number(props, d.p.share_of, 0.0) *
+                                                          (1 - json_number(props, d.p.name, 1.0))));
+    for (const auto& [k, v] : props.items()) {
+      const char* share = valid_share_of(k);
+      const bool rejected = share && json_number(props, share, 1.0) == 0;
+      all[k].push_back(v.is_number() && !rejected ? v.get<double>() : std::nan(""));
+    }
   }
   cached_ += ev.cached;
   for (const std::string& k : average_replicates(all, ev))
-    if ((!o_.ranks || o_.ranks->rank() == 0) && !(ev.rejected_disks > 0 && reads_the_disk(k)))
+    if ((!o_.ranks || o_.ranks->rank() == 0) && !(ev.rejected_tests > 0 && valid_share_of(k)))
       std::fprintf(stderr,
                    "[rocklab calibrate] warning: %s was not measured on every seed; the mean is "
                    "over those that measured it\n",

@@ -29,9 +29,9 @@ struct EvaluatorOptions {
 struct Evaluation {
   Measured mean, sd, se;
   std::vector<std::string> folders; ///< the suites' output folders, one per seed
-  /// Brazilian disks not valid (their fracture started at a platen, ISRM): the properties that
-  /// read the disk (bts_Pa, ucs_over_bts, ...) leave those seeds out of their means.
-  int rejected_disks = 0;
+  /// Tests not valid by their own rule (lab/property.hpp, validity_rules(): a Brazilian disk
+  /// fractured at a platen): the properties resting on them leave those seeds out of their means.
+  int rejected_tests = 0;
   int cached = 0; ///< seeds found in the cache
   /// CPU time of the test processes this rank ran for it over (wall time x cores), [0, 1];
   /// -1 when every seed came from the cache.

@@ -2,6 +2,7 @@
 
 #include "io/results.hpp"
 #include "lab/calibration/noise.hpp"
+#include "lab/property.hpp"
 #include "viz/svg_plots.hpp"
 
 #include <algorithm>
@@ -165,9 +166,8 @@ std::string validation_table(const ReportInput& r) {
     s += " |\n";
   }
   if (r.rejected + r.validation_rejected > 0)
-    s += "\nBrazilian disks left out of the means (not valid, ISRM: their fracture started at a "
-         "platen, or they failed without a split): " +
-         std::to_string(r.rejected) + " of " + std::to_string(r.seeds) + " tuned, " +
+    s += "\nTests left out of the means that rest on them (not valid: " + validity_rules() +
+         "): " + std::to_string(r.rejected) + " of " + std::to_string(r.seeds) + " tuned, " +
          std::to_string(r.validation_rejected) + " of " + std::to_string(nv) +
          " validation seeds.\n";
   return s;

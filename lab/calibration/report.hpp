@@ -25,7 +25,7 @@ struct ReportInput {
   Measured sd;   ///< over the seeds, at the final evaluation
   Measured se;   ///< standard error of the final evaluation's means (NaN: one seed)
   int seeds = 0; ///< replicate seeds of the final evaluation
-  int rejected = 0, validation_rejected = 0; ///< Brazilian disks not valid (ISRM), left out
+  int rejected = 0, validation_rejected = 0; ///< tests not valid (validity_rules()), left out
   /// The fitted card on fresh seeds it was never tuned on (empty: no validation was run).
   std::vector<std::uint64_t> validation_seeds;
   int validation_rounds = 0; ///< validations run (the last one's seeds and means are these)

@@ -18,7 +18,7 @@ namespace rocklab::calibration {
 struct ValidationRun {
   std::vector<std::uint64_t> seeds;
   Measured mean, sd, se;
-  int rejected = 0; ///< Brazilian disks not valid (ISRM), left out of the means that read them
+  int rejected = 0; ///< tests not valid (validity_rules()), left out of the means resting on them
 };
 /// Measures the card with these parameter values on fresh seeds.
 using Validate = std::function<ValidationRun(const std::vector<double>& values)>;

@@ -1,5 +1,6 @@
 #include "lab/calibration/stages.hpp"
 #include "lab/calibration/noise.hpp"
+#include "lab/property.hpp"
 
 #include <nlopt.hpp>
 
@@ -127,8 +128,16 @@ struct InertWatch {
   }
 };
 
+// What a target's property does in the stages and whether it is a stress, as the test that
+// measures it declares (lab/property.hpp); an undeclared name is a reported ratio.
+CalibrationRole role_of(const std::string& property) {
+  const SuiteProperty* d = find_property(property);
+  return d ? d->role : CalibrationRole::Reported;
+}
+
 bool is_stress(const std::string& property) {
-  return property.size() > 3 && property.ends_with("_Pa") && property != kYoungs;
+  const SuiteProperty* d = find_property(property);
+  return d && d->kind == PropertyKind::Stress;
 }
 
 // Each scale-free target's error in tolerances (a stress X as X / UCS against its target / the
@@ -138,7 +147,7 @@ std::vector<double> scale_free_errors(const Measured& m, const std::vector<const
                                       const Target* tu, std::vector<double>& se) {
   std::vector<double> e;
   se.clear();
-  const double u = value_of(m, kUcs);
+  const double u = value_of(m, tu->property);
   auto rel_se = [&](const std::string& key, double v) {
     const double s = value_of(m, se_key(key));
     return std::isfinite(s) && v != 0 ? s / std::abs(v) : 0.0;
@@ -149,7 +158,7 @@ std::vector<double> scale_free_errors(const Measured& m, const std::vector<const
       Target r = *t;
       r.value = t->value / tu->value;
       e.push_back(r.error(v / u));
-      se.push_back(std::hypot(rel_se(t->property, v), rel_se(kUcs, u)) * std::abs(v / u) /
+      se.push_back(std::hypot(rel_se(t->property, v), rel_se(tu->property, u)) * std::abs(v / u) /
                    (r.value * r.tolerance));
     } else {
       e.push_back(t->error(v));
@@ -187,9 +196,10 @@ struct Campaign {
   bool reseed = false;              ///< a seed was added: the same point is measured again
   std::vector<const Target*> noisy; ///< targets whose noise the notes name
 
-  const Target* target(const char* name) const {
+  /// The target whose property plays `r` in the stages, nullptr where none does.
+  const Target* target(CalibrationRole r) const {
     for (const Target& t : targets)
-      if (t.property == name)
+      if (role_of(t.property) == r)
         return &t;
     return nullptr;
   }
@@ -301,8 +311,8 @@ void Campaign::confirm() {
 // only between points at least 0.1 apart in log(ratio) (the older point is kept until then) and
 // held within [0.05, 0.5] per e-fold (bonded materials measure 0.1-0.2).
 void Campaign::elastic(int budget) {
-  const Target* tE = target(kYoungs);
-  const Target* tn = target(kPoisson);
+  const Target* tE = target(CalibrationRole::Modulus);
+  const Target* tn = target(CalibrationRole::StiffnessRatio);
   const bool steer_e = tE && has(Role::Modulus), steer_n = tn && has(Role::StiffnessRatio);
   if (!steer_e && !steer_n)
     return;
@@ -320,7 +330,7 @@ void Campaign::elastic(int budget) {
     if (step_n) {
       const auto k = std::find_if(p.begin(), p.end(),
                                   [](const Param& x) { return x.role == Role::StiffnessRatio; });
-      const double nu = value_of(m, kPoisson), lk = std::log(k->value);
+      const double nu = value_of(m, tn->property), lk = std::log(k->value);
       if (!std::isfinite(prev_n) || std::abs(lk - prev_k) >= 0.1) {
         if (std::isfinite(prev_n)) {
           const double secant = (nu - prev_n) / (lk - prev_k);
@@ -332,7 +342,7 @@ void Campaign::elastic(int budget) {
       const double step = std::clamp((tn->value - nu) / slope, -std::log(2.0), std::log(2.0));
       scale(Role::StiffnessRatio, std::exp(step));
     }
-    const double e = value_of(m, kYoungs);
+    const double e = step_e ? value_of(m, tE->property) : 0.0;
     if (step_e && e > 0)
       scale(Role::Modulus, std::clamp(tE->value / e, 0.25, 4.0));
   }
@@ -340,12 +350,12 @@ void Campaign::elastic(int budget) {
 
 // Stage 2: all strengths times target UCS / measured UCS.
 void Campaign::strength(int budget) {
-  const Target* tu = target(kUcs);
+  const Target* tu = target(CalibrationRole::Strength);
   if (!tu || !has(Role::Strength))
     return;
   for (int i = 0; i < budget; ++i) {
     const Measured m = run(Stage::Strength);
-    const double u = value_of(m, kUcs);
+    const double u = value_of(m, tu->property);
     if (met(tu, m) || !(u > 0))
       return;
     bool step = false;
@@ -395,11 +405,14 @@ void Campaign::ratios(int budget) {
   for (std::size_t i = 0; i < p.size(); ++i)
     if (p[i].role == Role::Shape)
       shape.push_back(i);
-  const Target* tu = target(kUcs);
+  const Target* tu = target(CalibrationRole::Strength);
   std::vector<const Target*> free;
-  for (const Target& t : targets)
-    if (t.property != kYoungs && t.property != kUcs && (!is_stress(t.property) || tu))
+  for (const Target& t : targets) {
+    const CalibrationRole r = role_of(t.property);
+    if (r != CalibrationRole::Modulus && r != CalibrationRole::Strength &&
+        (!is_stress(t.property) || tu))
       free.push_back(&t);
+  }
   if (shape.empty() || free.empty() || budget < 1)
     return;
   BestPoint best;

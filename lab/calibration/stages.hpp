@@ -42,10 +42,9 @@ struct Target {
   double error(double measured) const; ///< signed error in tolerances (|e| <= 1: met)
 };
 
-/// The property names each stage steers; any other target is reported, not steered.
-inline const char* const kYoungs = "youngs_modulus_Pa";
-inline const char* const kPoisson = "poisson_ratio";
-inline const char* const kUcs = "ucs_Pa";
+// Which target each stage steers is the property's declared role (lab/property.hpp: the
+// modulus and the stiffness ratio's target in stage 1, the strength scale's in stage 2; stage 3
+// takes the rest, stress targets relative to the strength's).
 
 /// Elastic and Strength need the tests that measure E, nu (short elastic loading) and the UCS;
 /// Ratios and Final need every test a target names.

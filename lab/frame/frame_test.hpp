@@ -9,6 +9,7 @@
 #include "io/results.hpp"
 #include "lab/frame/loading_frame.hpp"
 #include "lab/lab_protocol.hpp"
+#include "lab/property.hpp"
 #include "viz/svg_plots.hpp"
 
 #include <cmath>
@@ -27,15 +28,6 @@ struct PlotLabels {
   bool lateral = false; ///< also plot the axial stress against the lateral strain
   int map_axis = 1;     ///< the crack map's section normal (0 x, 1 y, 2 z)
   std::string curve = "axial stress vs axial strain"; ///< the load curve's legend
-};
-
-/// A property of the material that suites and calibrations derive from a test's results: its name
-/// in summary.json and as a calibration target, how many tests of that kind it needs, and a second
-/// kind of test it needs as well (nullptr: none).
-struct SuiteProperty {
-  const char* name;
-  int count = 1;
-  const char* other = nullptr;
 };
 
 /// What a suite gathers from its tests' results: values by name (set by the first test of the
@@ -89,8 +81,12 @@ public:
   /// default: none).
   virtual void plot_markers(const std::vector<LabSample>& /*samples*/, const nlohmann::json& /*r*/,
                             std::vector<PlotMarker>& /*m*/) const {}
-  /// The material properties this test gives suites and calibrations (default: none).
+  /// The material properties this test gives suites and calibrations, each with how it is shown
+  /// and used (lab/property.hpp; default: none).
   virtual std::vector<SuiteProperty> suite_properties() const { return {}; }
+  /// The keys of this test's results.json a suite shows per test (tests.csv, the suite's table
+  /// and summary.json's test rows; only name, label and kind are read; default: none).
+  virtual std::vector<SuiteProperty> result_columns() const { return {}; }
   /// Add this test's results.json to a suite's values (default: nothing).
   virtual void add_to_suite(const nlohmann::json& /*r*/, SuiteValues& /*v*/) const {}
   /// This test's part of a suite's material properties (summary.json), from what every test

@@ -307,8 +307,26 @@ public:
                   o["valid"].get<bool>() ? "valid (ISRM)" : "NOT valid (ISRM: discard the disk)");
     }
   }
+  std::vector<SuiteProperty> result_columns() const override {
+    return {{.name = "tensile_strength_Pa", .label = "tensile", .kind = PropertyKind::Stress}};
+  }
   std::vector<SuiteProperty> suite_properties() const override {
-    return {{"bts_Pa"}, {"brazilian_valid"}, {"brazilian_disks"}, {"bts_not_valid_Pa"}};
+    using enum PropertyKind;
+    return {{.name = "bts_Pa",
+             .label = "BTS",
+             .kind = Stress,
+             .headline = 4,
+             .method = "the largest load before the disk lost the tension across its loaded "
+                       "diameter",
+             .missing = "no valid disk; the disks not valid read {bts_not_valid_Pa:MPa}",
+             .valid_share = "brazilian_valid"},
+            {.name = "brazilian_valid",
+             .label = "valid disk share",
+             .method = "Brazilian disks valid by ISRM: a disk whose fracture started at a platen, "
+                       "or that failed without a split, is not",
+             .share_of = "brazilian_disks"},
+            {.name = "brazilian_disks", .label = "disks", .kind = Count},
+            {.name = "bts_not_valid_Pa", .label = "BTS of the disks not valid", .kind = Stress}};
   }
   // The mean strength of the valid disks (ISRM); none while no disk is valid (a strength from a
   // disk that failed at a platen is not the rock's): bts_not_valid_Pa, the mean of the disks that

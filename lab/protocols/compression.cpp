@@ -159,6 +159,15 @@ void CompressionTest::plot_markers(const std::vector<LabSample>& samples, const 
   add("crack_damage_stress_Pa", "crack_damage_axial_strain", "CD (volume reversal)");
 }
 
+std::vector<SuiteProperty> CompressionTest::result_columns() const {
+  using enum PropertyKind;
+  return {{.name = "confinement_Pa", .label = "conf", .kind = Stress},
+          {.name = "youngs_modulus_Pa", .label = "E", .kind = Modulus},
+          {.name = "poisson_ratio", .label = "nu"},
+          {.name = "peak_stress_Pa", .label = "peak", .kind = Stress},
+          {.name = "peak_deviator_Pa", .label = "deviator", .kind = Stress}};
+}
+
 void CompressionTest::add_to_suite(const nlohmann::json& r, SuiteValues& v) const {
   v.s3.push_back(json_number(r, "confinement_Pa", std::nan(""))); // 0 in a UCS
   v.s1.push_back(json_number(r, "peak_stress_Pa", std::nan("")));

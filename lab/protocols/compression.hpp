@@ -22,6 +22,8 @@ public:
   /// The crack-initiation and crack-damage stresses on the axial curve.
   void plot_markers(const std::vector<LabSample>& samples, const nlohmann::json& r,
                     std::vector<PlotMarker>& m) const override;
+  /// The confinement, E, nu, the peak stress and deviator.
+  std::vector<SuiteProperty> result_columns() const override;
   /// A point (confinement, peak stress) of the strength envelope.
   void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override;
 

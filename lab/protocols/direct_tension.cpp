@@ -43,8 +43,19 @@ public:
   PlotLabels plot_labels() const override {
     return {"strain [%] (compression positive)", "tensile stress [MPa]", false, 1};
   }
+  std::vector<SuiteProperty> result_columns() const override {
+    return {{.name = "youngs_modulus_Pa", .label = "E", .kind = PropertyKind::Modulus},
+            {.name = "tensile_strength_Pa", .label = "tensile", .kind = PropertyKind::Stress}};
+  }
   std::vector<SuiteProperty> suite_properties() const override {
-    return {{"direct_tension_Pa"}, {"direct_tension_over_bts", 1, "brazilian"}};
+    return {{.name = "direct_tension_Pa",
+             .label = "direct tension",
+             .kind = PropertyKind::Stress,
+             .headline = 5},
+            {.name = "direct_tension_over_bts",
+             .label = "DT/BTS",
+             .valid_share = "brazilian_valid",
+             .other = "brazilian"}};
   }
   void add_to_suite(const nlohmann::json& r, SuiteValues& v) const override {
     if (!v.has("direct_tension_Pa"))

@@ -29,8 +29,30 @@ public:
   }
   // The strength envelope through the UCS and the triaxial peaks (Hoek-Brown needs two).
   std::vector<SuiteProperty> suite_properties() const override {
-    return {
-        {"friction_angle_deg", 1, "ucs"}, {"cohesion_Pa", 1, "ucs"}, {"hoek_brown_mi", 2, "ucs"}};
+    using enum PropertyKind;
+    constexpr const char* kMohrCoulomb =
+        "{envelope_points} compression peak(s); Mohr-Coulomb needs 2 confinements";
+    return {{.name = "friction_angle_deg",
+             .label = "friction angle",
+             .kind = Angle,
+             .headline = 7,
+             .detail = "(R2 {mohr_coulomb_r2})",
+             .missing = kMohrCoulomb,
+             .other = "ucs"},
+            {.name = "cohesion_Pa",
+             .label = "cohesion",
+             .kind = Stress,
+             .headline = 8,
+             .missing = kMohrCoulomb,
+             .other = "ucs"},
+            {.name = "hoek_brown_mi",
+             .label = "Hoek-Brown m_i",
+             .headline = 9,
+             .detail = "({envelope_points} points, sigma3 up to {envelope_sigma3_max_over_ucs} "
+                       "UCS, fit error {hoek_brown_fit_error})",
+             .missing = "{envelope_points} compression peak(s); Hoek-Brown needs 3",
+             .count = 2,
+             .other = "ucs"}};
   }
   // Mohr-Coulomb from two confinements on, Hoek-Brown from three (the UCS counts as one).
   void suite_results(const SuiteValues& v, nlohmann::json& props) const override {

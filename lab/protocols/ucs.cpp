@@ -14,11 +14,30 @@ public:
   const char* name() const override { return "ucs"; }
   FrameSetup setup() const override { return compression_setup(); }
   std::vector<SuiteProperty> suite_properties() const override {
-    return {{"youngs_modulus_Pa"},
-            {"poisson_ratio"},
-            {"ucs_Pa"},
-            {"crack_initiation_over_ucs"},
-            {"ucs_over_bts", 1, "brazilian"}};
+    using enum PropertyKind;
+    return {{.name = "youngs_modulus_Pa",
+             .label = "E",
+             .kind = Modulus,
+             .headline = 1,
+             .role = CalibrationRole::Modulus},
+            {.name = "poisson_ratio",
+             .label = "nu",
+             .headline = 2,
+             .role = CalibrationRole::StiffnessRatio},
+            {.name = "ucs_Pa",
+             .label = "UCS",
+             .kind = Stress,
+             .headline = 3,
+             .role = CalibrationRole::Strength},
+            {.name = "crack_initiation_over_ucs",
+             .label = "CI/UCS",
+             .method = "crack volumetric strain (Martin & Chandler 1994), as laboratory cores are "
+                       "read; crack_initiation_count_over_ucs: the crack count onset"},
+            {.name = "ucs_over_bts",
+             .label = "UCS/BTS",
+             .headline = 6,
+             .valid_share = "brazilian_valid",
+             .other = "brazilian"}};
   }
   // The first UCS test gives E, nu, the UCS and the crack-initiation stresses. The laboratory's
   // crack initiation is read from the stress-strain curves (Nicksiar & Martin 2013: 376 tests,
