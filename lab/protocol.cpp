@@ -28,6 +28,8 @@ void read_common_loading(JsonObject& l, Protocol& p) {
     p.platen_velocity = l.number("platen_velocity", {0, 100, true, false}, std::nullopt, "m/s");
   p.ramp_steps = l.integer("ramp_steps", 0, 10'000'000, 2000);
   p.seating_stress = l.number("seating_stress", Range::positive(), 1e5, "Pa");
+  p.approach_stress = l.number("approach_stress", Range::closed(0, 1e10), 0.0, "Pa");
+  p.approach_rate = l.number("approach_rate", Range::closed(1, 20), 3.0);
   p.density_scaling = l.number("density_scaling", Range::half_open(0, 1), 0.0);
   if (l.has("timestep_safety"))
     p.timestep_safety = l.number("timestep_safety", {0, 1.6, true, false}, std::nullopt);

@@ -36,6 +36,10 @@ struct Protocol {
   double platen_velocity = 0;              ///< > 0: speed of each platen (or grip) [m/s]
   std::int64_t ramp_steps = 2000;          ///< the platen speed rises smoothly over this many steps
   double seating_stress = 1e5;             ///< platens first close to this axial stress [Pa]
+  /// Below this axial stress the loading runs at approach_rate times its rate, then slows to it
+  /// over ramp_steps (0: no approach) [Pa].
+  double approach_stress = 0;
+  double approach_rate = 3; ///< the approach's rate as a multiple of the loading rate [-]
   /// `loading.platen_friction`, the platens' ball-facet friction coefficient (0 lubricated, steel
   /// on rock unlubricated about 0.2-0.5); not given: the test's own (FrameTest::actuator: UCS,
   /// triaxial lubricated; Brazilian the specimen's wall rule).

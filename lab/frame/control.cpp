@@ -36,7 +36,7 @@ void LoadingFrame::control() {
     const double ramp = p_.ramp_steps > 0 ? static_cast<double>(m_.step() - ramp_start_step_) /
                                                 static_cast<double>(p_.ramp_steps)
                                           : 1.0;
-    v = v_final_ * smoothstep(ramp);
+    v = v_final_ * smoothstep(ramp) * approach_factor();
   } else if (phase_ == kUnload) {
     const double ramp = p_.ramp_steps > 0 ? static_cast<double>(m_.step() - reverse_step_) /
                                                 static_cast<double>(p_.ramp_steps)
@@ -44,6 +44,20 @@ void LoadingFrame::control() {
     v = v_final_ * (1 - 2 * smoothstep(ramp));
   }
   actuator_->drive(m_, geo_, v);
+}
+
+// A faster start through the seating compliance (a cushion's soft travel, the rim grains coming
+// into contact), where the specimen is still elastic: approach_rate times the rate until the axial
+// stress first reaches loading.approach_stress, then smoothly down to the rate.
+double LoadingFrame::approach_factor() const {
+  if (p_.approach_stress <= 0)
+    return 1.0;
+  if (approach_end_step_ < 0)
+    return p_.approach_rate;
+  const double x = p_.ramp_steps > 0 ? static_cast<double>(m_.step() - approach_end_step_) /
+                                           static_cast<double>(p_.ramp_steps)
+                                     : 1.0;
+  return p_.approach_rate + (1 - p_.approach_rate) * smoothstep(x);
 }
 
 } // namespace rocklab

@@ -206,6 +206,9 @@ void LoadingFrame::advance() {
     reload_strain0_ = current_.axial_strain;
   }
   reload_peak_ = std::max(reload_peak_, current_.load);
+  if (approach_end_step_ < 0 && p_.approach_stress > 0 &&
+      current_.axial_stress >= p_.approach_stress)
+    approach_end_step_ = m_.step(); // the approach ends: the platens slow to the loading rate
   const std::int64_t loading = m_.step() - load_start_step_;
   const std::int64_t fine = std::max<std::int64_t>(1, p_.history_every / 10);
   if (loading % fine == 0) {
@@ -311,6 +314,8 @@ template <class A> void LoadingFrame::fields(A& a) {
   a.object("peak", peak_);
   if (p_.density_scaling > 0) // (checkpoints of runs without it keep their old fields)
     a.object("density_scaling", density_);
+  if (p_.approach_stress > 0)
+    a("approach_end_step", approach_end_step_);
   a.object("confinement_band", band_);
   a("bond_break_events", bond_break_events_);
   a("next_snapshot_strain", next_snapshot_strain_), a("snapshot_due", snapshot_due_);
@@ -448,6 +453,11 @@ nlohmann::json LoadingFrame::results() const {
   r["peak_time_s"] = peak_.time;
   r["loading_rate"] = {{"platen_velocity_m_per_s", v_final_},
                        {"strain_rate_per_s", 2 * v_final_ / geo_.loaded_length()}};
+  if (p_.approach_stress > 0)
+    r["loading_rate"]["approach"] = {
+        {"stress_Pa", p_.approach_stress},
+        {"rate_multiple", p_.approach_rate},
+        {"reached_step", approach_end_step_ >= 0 ? nlohmann::json(approach_end_step_) : nullptr}};
   r["timestep_safety"] = m_.settings.timestep_safety;
   if (p_.density_scaling > 0)
     r["density_scaling"] = {

@@ -159,6 +159,9 @@ private:
   double shell_strain() const;
   // control.cpp
   void control();
+  /// The loading speed's factor for loading.approach_stress: approach_rate below it, easing to 1
+  /// over ramp_steps once it is reached, 1 without an approach.
+  double approach_factor() const;
   // loading_frame.cpp
   void record_history();
   void mark_energy_start();
@@ -185,13 +188,14 @@ private:
   int phase_ = kSeat;
   std::int64_t phase_start_step_ = 0, load_start_step_ = 0, reverse_step_ = -1;
   std::int64_t ramp_start_step_ = 0; ///< the loading ramp's start (loading, or a re-seating's end)
-  bool reseating_ = false;           ///< closing again to the seating stress while loading
-  std::int64_t reseat_step_ = 0;     ///< the step the last re-seating began
-  int reseats_ = 0;                  ///< re-seatings so far
-  double reload_peak_ = 0;           ///< largest load since the last re-seating ended [Pa]
-  double reload_strain0_ = 0;        ///< axial strain when the last re-seating ended [-]
-  double v_final_ = 0;               ///< platen (grip) speed while loading [m/s]
-  double sep_ref_ = 0;               ///< platen or grip separation when loading began [m]
+  std::int64_t approach_end_step_ = -1; ///< the step the approach stress was reached (-1: not yet)
+  bool reseating_ = false;              ///< closing again to the seating stress while loading
+  std::int64_t reseat_step_ = 0;        ///< the step the last re-seating began
+  int reseats_ = 0;                     ///< re-seatings so far
+  double reload_peak_ = 0;              ///< largest load since the last re-seating ended [Pa]
+  double reload_strain0_ = 0;           ///< axial strain when the last re-seating ended [-]
+  double v_final_ = 0;                  ///< platen (grip) speed while loading [m/s]
+  double sep_ref_ = 0;                  ///< platen or grip separation when loading began [m]
   std::vector<Vec3> shell_ref_;
   double load_ref_ = 0;         ///< load when loading began (the seating stress)
   std::vector<Vec3> reference_; ///< grain positions when the test began
