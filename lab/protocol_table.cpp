@@ -28,25 +28,45 @@ const Row kTests[] = {
     {"drop", make_drop_test},
 };
 
+// Tests registered from outside this table (a test fixture), after the table's.
+std::vector<Row>& registered() {
+  static std::vector<Row> rows;
+  return rows;
+}
+
+std::vector<Row> all_rows() {
+  std::vector<Row> rows(std::begin(kTests), std::end(kTests));
+  rows.insert(rows.end(), registered().begin(), registered().end());
+  return rows;
+}
+
 } // namespace
+
+bool register_lab_protocol(const char* name, std::unique_ptr<LabProtocol> (*make)()) {
+  for (const Row& r : all_rows())
+    if (std::string_view(name) == r.name)
+      return false;
+  registered().push_back({name, make});
+  return true;
+}
 
 std::vector<std::string> lab_protocol_names() {
   std::vector<std::string> names;
-  for (const Row& r : kTests)
+  for (const Row& r : all_rows())
     names.emplace_back(r.name);
   return names;
 }
 
 std::vector<std::string> frame_test_names() {
   std::vector<std::string> names;
-  for (const Row& r : kTests)
+  for (const Row& r : all_rows())
     if (dynamic_cast<FrameTest*>(r.make().get()))
       names.emplace_back(r.name);
   return names;
 }
 
 std::unique_ptr<LabProtocol> make_lab_protocol(std::string_view name) {
-  for (const Row& r : kTests)
+  for (const Row& r : all_rows())
     if (name == r.name)
       return r.make();
   return nullptr;

@@ -15,6 +15,10 @@ namespace rocklab {
 
 class FrameTest;
 
+/// Adds a test defined outside the table (a test fixture; the shipped tests are the table's rows),
+/// after the table's; false where the name is taken. Call before the first lookup: the declared
+/// properties and columns are gathered once.
+bool register_lab_protocol(const char* name, std::unique_ptr<LabProtocol> (*make)());
 /// The names of every test, in table order.
 std::vector<std::string> lab_protocol_names();
 /// The names of the tests run in the loading frame (protocol files with a specimen; suites).

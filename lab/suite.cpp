@@ -252,10 +252,10 @@ struct SuiteSummary {
 };
 
 std::string SuiteSummary::csv_header() {
-  std::string h = "name,test,status";
-  for (const SuiteProperty& c : test_columns())
-    h.append(",").append(c.name);
-  return h + ",cracks_tension,cracks_shear,grains,steps,wall_time_s\n";
+  std::string h;
+  for (const std::string& c : tests_csv_columns())
+    h.append(h.empty() ? "" : ",").append(c);
+  return h + "\n";
 }
 
 void SuiteSummary::add(const SuiteTest& t, const Job& j, OutputDir& out) {
@@ -313,6 +313,14 @@ nlohmann::json SuiteSummary::properties() const {
 }
 
 } // namespace
+
+std::vector<std::string> tests_csv_columns() {
+  std::vector<std::string> cols{"name", "test", "status"};
+  for (const SuiteProperty& c : test_columns())
+    cols.emplace_back(c.name);
+  cols.insert(cols.end(), {"cracks_tension", "cracks_shear", "grains", "steps", "wall_time_s"});
+  return cols;
+}
 
 std::vector<std::string> summary_columns() {
   std::vector<std::string> cols;

@@ -62,9 +62,12 @@ void say_genesis_estimates(const std::string& card_file, const std::string& file
 /// Returns the summary. Nothing is left in OUTDIR when it fails or is interrupted.
 nlohmann::json run_suite(const Suite& s, const SuiteOptions& o);
 
-/// summary.csv's property columns: the headline (E, nu, UCS, BTS, direct tension, UCS/BTS,
-/// friction angle, cohesion, m_i), then every other property a frame test declares (table order).
+/// summary.csv's property columns: the declared headline properties by their place (E, nu, UCS,
+/// BTS, direct tension, UCS/BTS, the envelope), then every other one a frame test declares.
 std::vector<std::string> summary_columns();
+/// tests.csv's columns: name, test, status, every test's declared result columns (table order),
+/// then cracks, grains, steps and wall time.
+std::vector<std::string> tests_csv_columns();
 
 /// The printed table of a summary (the headline properties, then a line of the others).
 std::string summary_table(const nlohmann::json& summary);

@@ -249,3 +249,40 @@ TEST(Printout, ACrackStressNoCrackMarkedReadsNotMeasuredNotZero) {
   EXPECT_EQ(line(), "crack stress initiation 90 MPa (0.45 of peak), volumetric 80 MPa; damage "
                     "150 MPa (0.75 of peak)");
 }
+
+TEST(Printout, AToyTestsPropertyReachesEveryTableFromItsOwnFile) {
+  // tests/fixtures/toy_point_load.cpp: a test file and its registration line, nothing else.
+  const auto names = frame_test_names();
+  ASSERT_NE(std::find(names.begin(), names.end(), "toy_point_load"), names.end());
+  const auto t = make_frame_test("toy_point_load");
+  const json r = {{"point_load_index_Pa", 4.2e6}};
+  EXPECT_EQ(printed(*t, r), "point load index 4.2 MPa\n"); // the printout
+  const auto cols = tests_csv_columns();                   // tests.csv
+  EXPECT_NE(std::find(cols.begin(), cols.end(), "point_load_index_Pa"), cols.end());
+  const auto sum = summary_columns(); // summary.csv
+  EXPECT_NE(std::find(sum.begin(), sum.end(), "point_load_index_Pa"), sum.end());
+  json row = {{"name", "pl"},
+              {"test", "toy_point_load"},
+              {"status", "ok"},
+              {"point_load_index_Pa", 4.2e6},
+              {"cracks", {{"total", 3}}},
+              {"wall_time_s", 1.0}};
+  const json summary = {{"suite", "s"},
+                        {"material", "m"},
+                        {"tests", {row}},
+                        {"properties", {{"point_load_index_Pa", 4.2e6}}}};
+  const std::string table = summary_table(summary); // the suite table: column and property
+  EXPECT_NE(table.find("Is [MPa]"), std::string::npos) << table;
+  EXPECT_NE(table.find("Is 4.2 MPa"), std::string::npos) << table;
+  bool target = false; // a calibration target, measured by the toy test
+  for (const calibration::TargetNeed& n : calibration::target_needs())
+    target = target || (std::string(n.property) == "point_load_index_Pa" &&
+                        std::string(n.test) == "toy_point_load");
+  EXPECT_TRUE(target);
+  // and a suite's summary.json gathers it through the test's own add_to_suite.
+  SuiteValues v;
+  t->add_to_suite(r, v);
+  json props = json::object();
+  t->suite_results(v, props);
+  EXPECT_DOUBLE_EQ(props["point_load_index_Pa"].get<double>(), 4.2e6);
+}

@@ -27,12 +27,6 @@ std::string load_fell_reason(const Protocol& p) {
   return "the load fell below " + format_double(p.post_peak_fraction) + " of its peak";
 }
 
-void print_tensile_strength(const nlohmann::json& r, const std::string& more) {
-  std::printf("tensile strength %.4g MPa (force %.4g N)%s\n",
-              1e-6 * json_number(r, "tensile_strength_Pa", 0.0),
-              json_number(r, "peak_force_N", 0.0), more.c_str());
-}
-
 double SuiteValues::get(const std::string& name) const {
   const auto it = values.find(name);
   return it == values.end() ? std::nan("") : it->second;

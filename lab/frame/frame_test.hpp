@@ -31,10 +31,11 @@ struct PlotLabels {
 };
 
 /// What a suite gathers from its tests' results: values by name (set by the first test of the
-/// kind that measures them) and the strength envelope's points.
+/// kind that measures them) and series by name, one entry per test that adds to them (the
+/// compression tests' confinements and peaks, from which the triaxial fits the envelope).
 struct SuiteValues {
   std::map<std::string, double> values;
-  std::vector<double> s3, s1; ///< confinement and peak stress of the compression tests [Pa]
+  std::map<std::string, std::vector<double>> series;
   /// The value, NaN when no test gave it.
   double get(const std::string& name) const;
   bool has(const std::string& name) const { return !std::isnan(get(name)); }
@@ -99,8 +100,5 @@ public:
 
 /// The stop reason of the standard post-peak rule.
 std::string load_fell_reason(const Protocol& p);
-
-/// The printout's tensile-strength line: "tensile strength X MPa (force F N)", then `more`.
-void print_tensile_strength(const nlohmann::json& r, const std::string& more = "");
 
 } // namespace rocklab

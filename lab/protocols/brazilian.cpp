@@ -12,6 +12,7 @@
 // peak (crushed at the platens) (docs/protocol-format.md).
 #include "lab/protocols/brazilian.hpp"
 #include "lab/frame/frame_test.hpp"
+#include "lab/protocols/tensile_strength.hpp"
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"

@@ -169,8 +169,8 @@ std::vector<SuiteProperty> CompressionTest::result_columns() const {
 }
 
 void CompressionTest::add_to_suite(const nlohmann::json& r, SuiteValues& v) const {
-  v.s3.push_back(json_number(r, "confinement_Pa", std::nan(""))); // 0 in a UCS
-  v.s1.push_back(json_number(r, "peak_stress_Pa", std::nan("")));
+  v.series[kEnvelopeSigma3].push_back(json_number(r, "confinement_Pa", std::nan(""))); // UCS: 0
+  v.series[kEnvelopeSigma1].push_back(json_number(r, "peak_stress_Pa", std::nan("")));
 }
 
 } // namespace rocklab

@@ -9,6 +9,10 @@
 
 namespace rocklab {
 
+/// The suite series of the compression tests' confinements and peak stresses [Pa].
+inline constexpr const char* kEnvelopeSigma3 = "envelope_sigma3_Pa";
+inline constexpr const char* kEnvelopeSigma1 = "envelope_sigma1_Pa";
+
 class CompressionTest : public FrameTest {
 public:
   /// loading.reverse_at_strain: > 0 unloads from this axial strain back to zero (elastic test).

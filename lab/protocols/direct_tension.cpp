@@ -2,6 +2,7 @@
 // constant rate; the tensile strength is the peak force over the initial section
 // (docs/protocol-format.md).
 #include "lab/frame/frame_test.hpp"
+#include "lab/protocols/tensile_strength.hpp"
 
 #include "io/json_input.hpp"
 #include "io/results.hpp"

@@ -56,7 +56,11 @@ public:
   }
   // Mohr-Coulomb from two confinements on, Hoek-Brown from three (the UCS counts as one).
   void suite_results(const SuiteValues& v, nlohmann::json& props) const override {
-    const Envelope env = fit_envelope(v.s3, v.s1);
+    const auto points = [&](const char* key) {
+      const auto it = v.series.find(key);
+      return it == v.series.end() ? std::vector<double>{} : it->second;
+    };
+    const Envelope env = fit_envelope(points(kEnvelopeSigma3), points(kEnvelopeSigma1));
     const nlohmann::json none = nullptr;
     props["friction_angle_deg"] = env.has_mc ? number_or_null(env.friction_angle_deg) : none;
     props["cohesion_Pa"] = env.has_mc ? number_or_null(env.cohesion) : none;
