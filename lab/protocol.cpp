@@ -91,9 +91,7 @@ Protocol protocol_from_json(const nlohmann::json& j, const std::string& file,
   p.file = file;
   p.raw = j;
   JsonObject top(j, file, key_path);
-  read_units(top);
-  p.name = top.string("name", "");
-  top.string("description", "");
+  p.name = read_header(top, "").name;
   p.test = top.choice("test", frame_test_names());
   p.frame_test = test_object ? std::move(test_object) : make_frame_test(p.test);
   FrameTest& test = *p.frame_test;

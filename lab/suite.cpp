@@ -46,9 +46,7 @@ Suite load_suite(const std::string& path) {
   const nlohmann::json j = read_json_file(path);
   s.text_hash = text_hash(read_input_text(path));
   JsonObject top(j, path, "");
-  read_units(top);
-  s.name = top.string("name", fs::path(path).stem().string());
-  top.string("description", "");
+  s.name = read_header(top, fs::path(path).stem().string()).name;
   {
     const std::string m = top.string("material");
     s.material_file = resolve(path, m);

@@ -271,10 +271,8 @@ MaterialCard load_material_card(const std::string& path) {
   c.text_hash = text_hash(read_input_text(path));
   c.raw = read_json_file(path);
   JsonObject top(c.raw, path, "");
-  read_units(top);
-  c.name = top.string("name");
+  c.name = read_header(top, std::nullopt).name;
   c.source = top.string("source", "");
-  top.string("description", "");
   c.dim = static_cast<int>(top.integer("dimension", 2, 3));
   c.density = top.number("density", Range::density(), std::nullopt, "kg/m^3");
   c.seed = static_cast<std::uint64_t>(

@@ -215,9 +215,7 @@ CalibrationFile load_calibration(const std::string& path) {
   std::string material_from;
   const nlohmann::json j = read_extended(path, material_from);
   JsonObject top(j, path, "");
-  read_units(top);
-  c.name = top.string("name", fs::path(path).stem().string());
-  top.string("description", "");
+  c.name = read_header(top, fs::path(path).stem().string()).name;
   top.string("source", "");
   const std::string m = top.string("material");
   c.material_file = resolve(material_from, m);

@@ -30,8 +30,7 @@ DropProtocol drop_protocol_from_json(const nlohmann::json& j, const std::string&
   JsonObject top(j, file, "");
   if (top.choice("test", {"drop"}) != "drop")
     top.fail("test", "expected \"drop\"");
-  read_units(top);
-  top.string("description", "");
+  read_header(top, "");
   p.dim = static_cast<int>(top.integer("dimension", 2, 3, 2));
   {
     JsonObject r = top.object("rock");

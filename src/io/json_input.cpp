@@ -42,6 +42,14 @@ void read_units(JsonObject& top) {
     top.fail("units", "only \"SI\" is supported (m, kg, s, N, Pa)");
 }
 
+FileHeader read_header(JsonObject& top, const std::optional<std::string>& default_name) {
+  read_units(top);
+  FileHeader h;
+  h.name = default_name ? top.string("name", *default_name) : top.string("name");
+  h.description = top.string("description", "");
+  return h;
+}
+
 std::string describe(const nlohmann::json& v) {
   std::string s = v.dump();
   if (s.size() > 60)

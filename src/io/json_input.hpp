@@ -44,6 +44,14 @@ class JsonObject;
 /// s, N, Pa) when given.
 void read_units(JsonObject& top);
 
+/// The header every input file may give, read in one place (read_header): its name and
+/// description (free text).
+struct FileHeader {
+  std::string name, description;
+};
+/// `units` (read_units), `name` (required where `default_name` is nullopt) and `description`.
+FileHeader read_header(JsonObject& top, const std::optional<std::string>& default_name);
+
 /// Why `path` cannot be an input file (a directory, a device or a socket), or "".
 std::string not_an_input_file(const std::string& path);
 /// The bytes of an input file; a directory, a device or an unreadable file is an input error.

@@ -198,8 +198,7 @@ Scene load_scene(const std::string& path) {
   JsonObject top(j, path, "");
   s.model = std::make_unique<Model>();
   Model& m = *s.model;
-  read_units(top);
-  s.description = top.string("description", "");
+  s.description = read_header(top, "").description;
   m.settings.dim = static_cast<int>(top.integer("dimension", 2, 3));
   const int dim = m.settings.dim;
   m.settings.gravity = top.vec("gravity", dim, Vec3::Zero());
