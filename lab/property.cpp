@@ -29,6 +29,16 @@ const SuiteProperty* find_property(const std::string& name) {
   return nullptr;
 }
 
+CalibrationRole property_role(const std::string& name) {
+  const SuiteProperty* d = find_property(name);
+  return d ? d->role : CalibrationRole::Reported;
+}
+
+PropertyKind property_kind(const std::string& name) {
+  const SuiteProperty* d = find_property(name);
+  return d ? d->kind : PropertyKind::Ratio;
+}
+
 std::string validity_rules() {
   std::string out;
   for (const DeclaredProperty& d : declared_properties())

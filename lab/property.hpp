@@ -64,6 +64,10 @@ const std::vector<DeclaredProperty>& declared_properties();
 /// The declaration of `name`, nullptr when no test declares it.
 const SuiteProperty* find_property(const std::string& name);
 
+/// The role and kind `name` is declared with (an undeclared name: a reported ratio).
+CalibrationRole property_role(const std::string& name);
+PropertyKind property_kind(const std::string& name);
+
 /// How the declared shares of valid tests judge validity (their method texts, "; "-joined): what
 /// a calibration says of the tests it left out.
 std::string validity_rules();

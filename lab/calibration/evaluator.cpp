@@ -52,6 +52,17 @@ nlohmann::json Evaluator::tests_of(Stage s) const {
 }
 
 namespace {
+// A seed's tests that were not valid: each declared share of valid tests times what it is a share
+// of.
+int not_valid_tests(const nlohmann::json& props) {
+  int n = 0;
+  for (const DeclaredProperty& d : declared_properties())
+    if (d.p.share_of)
+      n += static_cast<int>(std::lround(json_number(props, d.p.share_of, 0.0) *
+                                        (1 - json_number(props, d.p.name, 1.0))));
+  return n;
+}
+
 // The share of valid tests a property rests on (lab/property.hpp), nullptr where every test counts.
 const char* valid_share_of(const std::string& property) {
   const SuiteProperty* d = find_property(property);
@@ -286,16 +297,12 @@ Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
       if ((!ranks || ranks->rank() == 0) && own && !rows_.find(reps[i].key))
         rows_.add(reps[i].key, reps[i].seed, props); // a cached folder's row
     }
-    // The tests of this seed that were not valid (each declared share of valid tests times what
-    // it is a share of); a property resting on a share of 0 is left out of this seed.
-    for (const DeclaredProperty& d : declared_properties())
-      if (d.p.share_of)
-        ev.rejected_tests += static_cast<int>(std::lround(json_number(props, d.p.share_of, 0.0) *
-                                                          (1 - json_number(props, d.p.name, 1.0))));
+    ev.rejected_tests += not_valid_tests(props);
     for (const auto& [k, v] : props.items()) {
-      const char* share = valid_share_of(k);
-      const bool rejected = share && json_number(props, share, 1.0) == 0;
-      all[k].push_back(v.is_number() && !rejected ? v.get<double>() : std::nan(""));
+      const char* share = valid_share_of(k); // a property resting on a share of 0: left out
+      all[k].push_back(v.is_number() && !(share && json_number(props, share, 1.0) == 0)
+                           ? v.get<double>()
+                           : std::nan(""));
     }
   }
   cached_ += ev.cached;

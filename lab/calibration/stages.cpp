@@ -128,16 +128,13 @@ struct InertWatch {
   }
 };
 
-// What a target's property does in the stages and whether it is a stress, as the test that
-// measures it declares (lab/property.hpp); an undeclared name is a reported ratio.
+// What a target's property does in the stages and whether it is a stress: as the test that
+// measures it declares (lab/property.hpp).
 CalibrationRole role_of(const std::string& property) {
-  const SuiteProperty* d = find_property(property);
-  return d ? d->role : CalibrationRole::Reported;
+  return property_role(property);
 }
-
 bool is_stress(const std::string& property) {
-  const SuiteProperty* d = find_property(property);
-  return d && d->kind == PropertyKind::Stress;
+  return property_kind(property) == PropertyKind::Stress;
 }
 
 // Each scale-free target's error in tolerances (a stress X as X / UCS against its target / the
