@@ -8,17 +8,29 @@
 
 namespace rocklab {
 
+namespace {
+
+// Every entry a frame test declares through `list`, in the protocol table's order, each name once
+// (with the first test that declares it).
+std::vector<DeclaredProperty> gather(std::vector<SuiteProperty> (FrameTest::*list)() const) {
+  std::vector<DeclaredProperty> out;
+  for (const std::string& test : frame_test_names())
+    for (const SuiteProperty& p : (*make_frame_test(test).*list)()) // literals: outlive the test
+      if (std::none_of(out.begin(), out.end(),
+                       [&](const DeclaredProperty& d) { return std::string(d.p.name) == p.name; }))
+        out.push_back({p, test});
+  return out;
+}
+
+} // namespace
+
 const std::vector<DeclaredProperty>& declared_properties() {
-  static const std::vector<DeclaredProperty> all = [] {
-    std::vector<DeclaredProperty> out;
-    for (const std::string& test : frame_test_names())
-      for (const SuiteProperty& p : make_frame_test(test)->suite_properties()) // literals
-        if (std::none_of(out.begin(), out.end(), [&](const DeclaredProperty& d) {
-              return std::string(d.p.name) == p.name;
-            }))
-          out.push_back({p, test});
-    return out;
-  }();
+  static const std::vector<DeclaredProperty> all = gather(&FrameTest::suite_properties);
+  return all;
+}
+
+const std::vector<DeclaredProperty>& declared_result_columns() {
+  static const std::vector<DeclaredProperty> all = gather(&FrameTest::result_columns);
   return all;
 }
 

@@ -61,6 +61,8 @@ struct DeclaredProperty {
   std::string test;
 };
 const std::vector<DeclaredProperty>& declared_properties();
+/// Every results.json key the frame tests declare as a per-test column (result_columns), alike.
+const std::vector<DeclaredProperty>& declared_result_columns();
 /// The declaration of `name`, nullptr when no test declares it.
 const SuiteProperty* find_property(const std::string& name);
 

@@ -208,18 +208,12 @@ std::vector<Job> SuiteRun::run_tests(const std::map<std::string, std::string>& s
 }
 
 // The per-test columns of tests.csv, summary.json's test rows and the printed table: every
-// results.json key a frame test declares for them, in table order, each once.
-const std::vector<SuiteProperty>& test_columns() {
-  static const std::vector<SuiteProperty> cols = [] {
-    std::vector<SuiteProperty> out;
-    for (const std::string& test : frame_test_names())
-      for (const SuiteProperty& c : make_frame_test(test)->result_columns())
-        if (std::none_of(out.begin(), out.end(),
-                         [&](const SuiteProperty& o) { return std::string(o.name) == c.name; }))
-          out.push_back(c);
-    return out;
-  }();
-  return cols;
+// results.json key a frame test declares for them (lab/property.hpp).
+std::vector<SuiteProperty> test_columns() {
+  std::vector<SuiteProperty> out;
+  for (const DeclaredProperty& d : declared_result_columns())
+    out.push_back(d.p);
+  return out;
 }
 
 // The declared properties in the order a suite shows them: the headline ones by their place, then

@@ -128,11 +128,8 @@ struct InertWatch {
   }
 };
 
-// What a target's property does in the stages and whether it is a stress: as the test that
-// measures it declares (lab/property.hpp).
-CalibrationRole role_of(const std::string& property) {
-  return property_role(property);
-}
+// Whether a target's property is a stress, as the test that measures it declares
+// (lab/property.hpp).
 bool is_stress(const std::string& property) {
   return property_kind(property) == PropertyKind::Stress;
 }
@@ -196,7 +193,7 @@ struct Campaign {
   /// The target whose property plays `r` in the stages, nullptr where none does.
   const Target* target(CalibrationRole r) const {
     for (const Target& t : targets)
-      if (role_of(t.property) == r)
+      if (property_role(t.property) == r)
         return &t;
     return nullptr;
   }
@@ -405,7 +402,7 @@ void Campaign::ratios(int budget) {
   const Target* tu = target(CalibrationRole::Strength);
   std::vector<const Target*> free;
   for (const Target& t : targets) {
-    const CalibrationRole r = role_of(t.property);
+    const CalibrationRole r = property_role(t.property);
     if (r != CalibrationRole::Modulus && r != CalibrationRole::Strength &&
         (!is_stress(t.property) || tu))
       free.push_back(&t);
