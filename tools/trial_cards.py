@@ -30,7 +30,7 @@ COLUMNS = ["trial", "test", "seed", "strength_Pa", "youngs_modulus_Pa", "poisson
            "ci_ratio", "ci_volumetric_ratio", "valid", "ledger_error", "steps", "wall_s",
            "stop_reason", "card_changes"]
 # Lac du Bonnet (../shared/reference/rock-targets.md): the ratios a granite card aims at.
-TARGET = {"ucs_over_bts": 21.5, "ucs_over_dt": 200 / 6.9}
+TARGET = {"ucs_over_bts": 21.5, "ucs_over_dt": 200 / 6.9, "nu": 0.26}
 
 
 def parse_trial(text):
@@ -119,6 +119,16 @@ def mean(xs):
     return sum(xs) / len(xs) if xs else float("nan")
 
 
+def per_seed(tests):
+    """Each seed's own ratios and Poisson's ratio (the figure's bars), seeds with both tests only."""
+    by = lambda test: {r["seed"]: r for r in tests.get(test, [])}
+    ucs, bts, dt = by("ucs"), by("brazilian"), by("direct_tension")
+    s = lambda rows, k: ps.num(rows[k]["strength_Pa"])
+    return {"ucs_over_dt": [s(ucs, k) / s(dt, k) for k in ucs if k in dt],
+            "ucs_over_bts": [s(ucs, k) / s(bts, k) for k in ucs if k in bts],
+            "nu": [ps.num(r["poisson_ratio"]) for r in ucs.values()]}
+
+
 def summarize(out):
     rows = list(csv.DictReader(open(os.path.join(out, "rows.csv"))))
     trials = {}
@@ -137,7 +147,8 @@ def summarize(out):
                         "E": mean(g("ucs", "youngs_modulus_Pa")), "nu": mean(g("ucs", "poisson_ratio")),
                         "ucs": ucs, "bts": bts, "dt": dt,
                         "valid": "%d of %d" % (valid.count("True"), len(valid)) if valid else "-",
-                        "ucs_over_bts": ucs / bts, "ucs_over_dt": ucs / dt, "ci": ci})
+                        "ucs_over_bts": ucs / bts, "ucs_over_dt": ucs / dt, "ci": ci,
+                        "per_seed": per_seed(t["tests"])})
     return summary
 
 
@@ -145,36 +156,82 @@ def fmt(v, f="%.1f", scale=1.0):
     return f % (v / scale) if math.isfinite(v) else "-"
 
 
+def step_of(span):
+    """A round tick step giving 4-8 ticks over span."""
+    base = 10 ** math.floor(math.log10(span / 5))
+    return next(m * base for m in (1, 2, 5, 10) if span / (m * base) <= 8)
+
+
+def nice_range(values):
+    """The means' range padded to round ticks (bars reaching past it are clipped at the frame)."""
+    lo, hi = min(values), max(values)
+    step = step_of((hi - lo) * 1.2 or 1.0)
+    return math.floor(lo / step - 0.3) * step, math.ceil(hi / step + 0.3) * step
+
+
+def ticks_of(lo, hi):
+    step = step_of(hi - lo)
+    return [k * step for k in range(math.ceil(lo / step - 1e-9), math.floor(hi / step + 1e-9) + 1)]
+
+
+def panel(e, box, pts, xlab, ylab, target, yticks="%g"):
+    """One scatter panel in box (left, top, width, height): points (x, y, xlo, xhi, ylo, yhi, name)
+    with their seeds' range as bars, the rock's pair as a red cross."""
+    left, top, w, h = box
+    (x0, x1), (y0, y1) = [nice_range([p[i] for p in pts] + [target[i]]) for i in (0, 1)]
+    X = lambda x: left + (min(max(x, x0), x1) - x0) / (x1 - x0) * w
+    Y = lambda y: top + h - (min(max(y, y0), y1) - y0) / (y1 - y0) * h
+    e.append('<rect x="%d" y="%d" width="%d" height="%d" fill="none" stroke="black"/>'
+             % (left, top, w, h))
+    for v in ticks_of(x0, x1):
+        e.append('<text x="%.0f" y="%d" text-anchor="middle">%g</text>' % (X(v), top + h + 16, v))
+    for v in ticks_of(y0, y1):
+        e.append('<text x="%d" y="%.0f" text-anchor="end">%s</text>' % (left - 6, Y(v) + 4, yticks % v))
+    e.append('<text x="%d" y="%d" text-anchor="middle">%s</text>' % (left + w // 2, top + h + 36, xlab))
+    cy = top + h // 2
+    e.append('<text x="%d" y="%d" transform="rotate(-90 %d %d)" text-anchor="middle">%s</text>'
+             % (left - 44, cy, left - 44, cy, ylab))
+    tx, ty = X(target[0]), Y(target[1])
+    e.append('<path d="M%.0f %.0f l12 12 m0 -12 l-12 12" stroke="#c00" stroke-width="2"/>'
+             % (tx - 6, ty - 6))
+    e.append('<text x="%.0f" y="%.0f" fill="#c00" text-anchor="end">Lac du Bonnet</text>'
+             % (tx - 8, ty + 18))
+    for x, y, xlo, xhi, ylo, yhi, name in pts:
+        e.append('<path d="M%.1f %.1f H%.1f M%.1f %.1f V%.1f" stroke="#88a"/>'
+                 % (X(xlo), Y(y), X(xhi), X(x), Y(ylo), Y(yhi)))
+        e.append('<circle cx="%.1f" cy="%.1f" r="4" fill="#246"/>' % (X(x), Y(y)))
+        e.append('<text x="%.1f" y="%.1f">%s</text>' % (X(x) + 6, Y(y) - 5, name))
+
+
 def svg(summary, path):
-    """UCS/BTS against UCS/direct tension, one point per trial, the rock's pair as a cross."""
-    pts = [(s["ucs_over_dt"], s["ucs_over_bts"], s["trial"]) for s in summary
-           if math.isfinite(s["ucs_over_dt"]) and math.isfinite(s["ucs_over_bts"])]
-    xs = [p[0] for p in pts] + [TARGET["ucs_over_dt"]]
-    ys = [p[1] for p in pts] + [TARGET["ucs_over_bts"]]
-    x0, x1 = 0.9 * min(xs), 1.1 * max(xs)
-    y0, y1 = 0.9 * min(ys), 1.1 * max(ys)
-    W, H, L, B = 640, 460, 70, 50
-    X = lambda x: L + (x - x0) / (x1 - x0) * (W - L - 20)
-    Y = lambda y: H - B - (y - y0) / (y1 - y0) * (H - B - 20)
+    """Left: UCS/BTS against UCS/direct tension (the trials with a disk); right: Poisson's ratio
+    against UCS/direct tension (every trial: what the shape keys cost in the elastic targets).
+    One point per trial (its seeds' mean ratio), bars over its seeds' range."""
+    def rng(s, key):
+        v = [x for x in s["per_seed"][key] if math.isfinite(x)]
+        return (min(v), max(v)) if v else (float("nan"),) * 2
+    left, right = [], []
+    for s in summary:
+        if not math.isfinite(s["ucs_over_dt"]):
+            continue
+        xr = rng(s, "ucs_over_dt")
+        right.append((s["ucs_over_dt"], s["nu"]) + xr + rng(s, "nu") + (s["trial"],))
+        if math.isfinite(s["ucs_over_bts"]):
+            left.append((s["ucs_over_dt"], s["ucs_over_bts"]) + xr + rng(s, "ucs_over_bts")
+                        + (s["trial"],))
+    W, H = 1100, 470
     e = ['<svg xmlns="http://www.w3.org/2000/svg" width="%d" height="%d" font-family="sans-serif" '
          'font-size="12"><rect width="100%%" height="100%%" fill="white"/>' % (W, H),
-         '<line x1="%d" y1="%d" x2="%d" y2="%d" stroke="black"/>' % (L, H - B, W - 20, H - B),
-         '<line x1="%d" y1="%d" x2="%d" y2="20" stroke="black"/>' % (L, H - B, L)]
-    for i in range(6):
-        xv, yv = x0 + i * (x1 - x0) / 5, y0 + i * (y1 - y0) / 5
-        e.append('<text x="%.0f" y="%d" text-anchor="middle">%.1f</text>' % (X(xv), H - B + 16, xv))
-        e.append('<text x="%d" y="%.0f" text-anchor="end">%.1f</text>' % (L - 6, Y(yv) + 4, yv))
-    e.append('<text x="%d" y="%d" text-anchor="middle">UCS / direct tension [-]</text>'
-             % ((L + W - 20) // 2, H - 12))
-    e.append('<text x="16" y="%d" transform="rotate(-90 16 %d)" text-anchor="middle">'
-             'UCS / BTS [-]</text>' % ((H - B) // 2, (H - B) // 2))
-    tx, ty = X(TARGET["ucs_over_dt"]), Y(TARGET["ucs_over_bts"])
-    e.append('<path d="M%.0f %.0f l12 12 m0 -12 l-12 12" stroke="#c00" stroke-width="2" '
-             'transform="translate(-6 -6)"/>' % (tx, ty))
-    e.append('<text x="%.0f" y="%.0f" fill="#c00">Lac du Bonnet</text>' % (tx + 9, ty - 6))
-    for x, y, name in pts:
-        e.append('<circle cx="%.1f" cy="%.1f" r="4" fill="#246"/>' % (X(x), Y(y)))
-        e.append('<text x="%.1f" y="%.1f">%s</text>' % (X(x) + 6, Y(y) + 4, name))
+         '<text x="%d" y="22" text-anchor="middle" font-size="14">3D flat-jointed granite: what the '
+         'card\'s shape keys reach (seeds\' mean, bars: their range)</text>' % (W // 2)]
+    if left:
+        panel(e, (80, 50, 420, 350), left, "UCS / direct tension [-]", "UCS / BTS [-]",
+              (TARGET["ucs_over_dt"], TARGET["ucs_over_bts"]))
+    panel(e, (630, 50, 420, 350), right, "UCS / direct tension [-]", "Poisson's ratio [-]",
+          (TARGET["ucs_over_dt"], TARGET["nu"]), yticks="%.2f")
+    e.append('<text x="80" y="%d" fill="#555">Bars reaching past a frame are cut at it. Trials: '
+             'tools/trial_cards.py; rows: docs/data/issue55/shape_sweep_rows.csv. Units SI.</text>'
+             % (H - 12))
     e.append("</svg>")
     open(path, "w").write("\n".join(e) + "\n")
 
