@@ -167,8 +167,9 @@ void ConfiningWalls::gather_follow_sums(const Model& m) {
   }
 }
 
-void ConfiningWalls::control(Model& m, const SpecimenGeometry& g, double h, double target,
+void ConfiningWalls::control(Model& m, const SpecimenGeometry& g, double h,
                              const std::vector<double>& wall_k) {
+  const double target = target_;
   // Each wall follows the grains that touch it (feed-forward: the force-weighted mean of their
   // velocity along the wall normal, so a dilating specimen is followed without a standing
   // error), plus a proportional term that closes the whole stress error in one step and a small

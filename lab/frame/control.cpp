@@ -21,14 +21,14 @@ double smoothstep(double x) {
 void LoadingFrame::control() {
   // Confining walls hold the confinement in every phase; the platens servo to their stress while
   // confining and seating, and move at the loading rate after it.
-  const bool servo = phase_ == kConfine || phase_ == kSeat || (phase_ == kLoad && reseating_);
-  if (confinement_.mounted() || servo)
+  const bool servo = phase_ == kConfine || phase_ == kSeat || (phase_ == kLoad && seating_again_);
+  if (confinement_ || servo)
     wall_stiffness_sums(m_, wall_k_); // the servo gains, reused buffer
-  if (confinement_.mounted())
-    confinement_.control(m_, geo_, wall_height(), setup_.confinement, wall_k_);
+  if (confinement_)
+    confinement_->control(m_, geo_, wall_height(), wall_k_);
   double v = 0;
   if (servo) {
-    const double target = phase_ == kConfine ? setup_.confinement : p_.seating_stress;
+    const double target = phase_ == kConfine ? confining_stress() : p_.seating_stress;
     v = machine_servo_velocity(m_, geo_, wall_k_[static_cast<std::size_t>(actuator_->wall())],
                                target, current_area(0), current_.axial_stress);
   } else if (phase_ == kLoad) {

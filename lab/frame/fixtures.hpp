@@ -1,7 +1,7 @@
 // The fixtures a test mounts in the loading frame: what carries the load along the axis (flat
 // platens, ISRM curved jaws, or grips holding the end grains) and the confining walls of a
 // triaxial (2D: biaxial) test with their stress servo. A test chooses them (FrameTest::actuator,
-// FrameSetup::confinement); the frame (loading_frame.hpp) drives and reads them through these
+// FrameTest::confinement); the frame (loading_frame.hpp) drives and reads them through these
 // classes only. Units SI; forces and stresses compression positive.
 #pragma once
 
@@ -105,6 +105,11 @@ private:
 /// the sides), each servo-controlled to the confining stress.
 class ConfiningWalls {
 public:
+  /// Walls that hold `target` [Pa]; the confining phase ends once every wall is within
+  /// `tolerance` x target of it.
+  ConfiningWalls(double target, double tolerance) : target_(target), tolerance_(tolerance) {}
+  double target() const { return target_; }       ///< the confining stress [Pa]
+  double tolerance() const { return tolerance_; } ///< the confining phase's band [-]
   void mount(Model& m, const SpecimenGeometry& g, const LinearProps& contact);
   bool mounted() const { return !walls_.empty(); }
   const std::vector<std::int64_t>& walls() const { return walls_; }
@@ -119,10 +124,10 @@ public:
   double strain(const Model& m, const SpecimenGeometry& g) const;
   /// The walls' widths (the cylinder's radius) when loading begins.
   void mark_reference(const Model& m, const SpecimenGeometry& g);
-  /// One servo step towards the confining stress `target` [Pa]: each wall follows the grains
-  /// that touch it and closes its stress error (`wall_k`: the stiffness sum of each wall's
-  /// contacts, wall_stiffness_sums).
-  void control(Model& m, const SpecimenGeometry& g, double height, double target,
+  /// One servo step towards the confining stress: each wall follows the grains that touch it
+  /// and closes its stress error (`wall_k`: the stiffness sum of each wall's contacts,
+  /// wall_stiffness_sums).
+  void control(Model& m, const SpecimenGeometry& g, double height,
                const std::vector<double>& wall_k);
   /// Checkpoint fields (the frame's state object's keys).
   template <class A> void fields(A& a) {
@@ -137,6 +142,7 @@ private:
   double face_area(const Model& m, const SpecimenGeometry& g, double height, std::size_t k) const;
   double stress(const Model& m, const SpecimenGeometry& g, double height, std::size_t k) const;
   void gather_follow_sums(const Model& m);
+  double target_, tolerance_;
   std::vector<std::int64_t> walls_;
   std::vector<int> axis_;        ///< axis of each (-1: the cylinder)
   std::vector<double> sign_;     ///< +1 for the wall on the + side

@@ -55,6 +55,8 @@ public:
   virtual FrameSetup setup() const = 0;
   /// What carries the load (default: flat platens with the protocol's loading.platen_friction).
   virtual std::unique_ptr<Actuator> actuator(const Protocol& p) const;
+  /// The confining walls of a confined test (default: none).
+  virtual std::unique_ptr<ConfiningWalls> confinement() const { return nullptr; }
   /// The specimen's shape from its genesis record ("" without one): by default not a disk.
   virtual void check_shape(const std::string& shape, const Protocol& p) const;
   /// The specimen's shape as its genesis recorded it (the report's `specimen`; null without a

@@ -96,7 +96,8 @@ void LoadingFrame::begin_loading() {
   shell_ref_.clear();
   for (std::int32_t i : shell_)
     shell_ref_.push_back(m_.balls.pos[static_cast<std::size_t>(i)]);
-  confinement_.mark_reference(m_, geo_);
+  if (confinement_)
+    confinement_->mark_reference(m_, geo_);
   LabSample s;
   measure(s);
   load_ref_ = s.load;
@@ -185,8 +186,8 @@ void LoadingFrame::advance() {
   if (phase_ == kConfine || phase_ == kSeat) {
     // The platens (and confining walls) servo to their stress; loading begins once every wall is
     // within its band and the specimen is at rest.
-    const double target = phase_ == kConfine ? setup_.confinement : p_.seating_stress;
-    const double tol = phase_ == kConfine ? setup_.confinement_tolerance : 0.1;
+    const double target = phase_ == kConfine ? confining_stress() : p_.seating_stress;
+    const double tol = phase_ == kConfine ? confinement_->tolerance() : 0.1;
     if (servoed_to(target, tol, since)) {
       record_history();
       begin_loading();
@@ -199,13 +200,10 @@ void LoadingFrame::advance() {
     return;
   }
   // Loading or unloading.
-  if (reseating_ && servoed_to(p_.seating_stress, 0.1, m_.step() - reseat_step_)) {
-    reseating_ = false; // seated again (as the seating phase): load on after the ramp
+  if (seating_again_ && servoed_to(p_.seating_stress, 0.1, m_.step() - seat_again_step_)) {
+    seating_again_ = false; // seated again (as the seating phase): load on after the ramp
     ramp_start_step_ = m_.step();
-    reload_peak_ = current_.load;
-    reload_strain0_ = current_.axial_strain;
   }
-  reload_peak_ = std::max(reload_peak_, current_.load);
   if (approach_end_step_ < 0 && p_.approach_stress > 0 &&
       current_.axial_stress >= p_.approach_stress)
     approach_end_step_ = m_.step(); // the approach ends: the platens slow to the loading rate
@@ -215,7 +213,7 @@ void LoadingFrame::advance() {
     samples_.push_back(current_);
     test_.sampled(*this, current_);
   }
-  if (confinement_.mounted())
+  if (confinement_)
     band_.add(current_.lateral_stress);
   track_peak();
   if (p_.vtk && p_.vtk_every_strain > 0 && phase_ == kLoad &&
@@ -235,17 +233,17 @@ bool LoadingFrame::servoed_to(double target, double tol, std::int64_t since) con
   if (since % 100 != 0 || since < 200)
     return false;
   const bool ok = std::abs(current_.axial_stress - target) <= tol * target &&
-                  confinement_.within(m_, geo_, wall_height(), target, tol);
+                  (!confinement_ || confinement_->within(m_, geo_, wall_height(), target, tol));
   return ok && m_.mean_unbalanced_force_ratio() <= 1e-2;
 }
 
-void LoadingFrame::reseat() {
-  if (actuator_->wall() < 0 || phase_ != kLoad || reseating_)
-    return;
-  reseating_ = true;
-  reseat_step_ = m_.step();
-  ++reseats_;
+bool LoadingFrame::seat_again() {
+  if (actuator_->wall() < 0 || phase_ != kLoad || seating_again_)
+    return false;
+  seating_again_ = true;
+  seat_again_step_ = m_.step();
   record_history();
+  return true;
 }
 
 void LoadingFrame::track_peak() {
@@ -305,10 +303,10 @@ template <class A> void LoadingFrame::fields(A& a) {
   a.object("geometry", geo_);
   a("phase", phase_), a("phase_start_step", phase_start_step_);
   a("load_start_step", load_start_step_), a("reverse_step", reverse_step_);
-  a("ramp_start_step", ramp_start_step_), a("reseating", reseating_), a("reseats", reseats_);
-  a("reseat_step", reseat_step_);
-  a("reload_peak", reload_peak_), a("reload_strain0", reload_strain0_);
-  confinement_.fields(a); // the fixture's fields; the actuator's: state(), restore()
+  a("ramp_start_step", ramp_start_step_), a("seating_again", seating_again_);
+  a("seat_again_step", seat_again_step_);
+  if (confinement_)
+    confinement_->fields(a); // the fixture's fields; the actuator's: state(), restore()
   a("shell", shell_), a("v_final", v_final_), a("sep_ref", sep_ref_), a("shell_ref", shell_ref_);
   a("load_ref", load_ref_), a("reference", reference_);
   a.object("peak", peak_);
@@ -352,7 +350,10 @@ void LoadingFrame::restore(const nlohmann::json& s, const std::string& file) {
   const auto balls = static_cast<std::int32_t>(m_.balls.size());
   check(phase_ >= kConfine && phase_ <= kDone, "phase");
   actuator_->restore(s, file, m_);
-  confinement_.check(m_, file);
+  if (confinement_)
+    confinement_->check(m_, file);
+  else if (s.contains("lateral"))
+    throw InputError(file + ": corrupt checkpoint (confining walls in an unconfined test's state)");
   for (std::int32_t i : shell_)
     check(i >= 0 && i < balls, "grain index");
   check(shell_ref_.empty() || shell_ref_.size() == shell_.size(), "lateral-surface grains");

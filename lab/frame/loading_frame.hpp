@@ -42,11 +42,9 @@ struct LabSample {
   double force = 0;          ///< platen (grip) force [N], 2D per unit thickness
 };
 
-/// How a test wants the frame set up (its fixtures: FrameTest::actuator and the confinement).
+/// How a test wants the frame set up (its fixtures: FrameTest::actuator, FrameTest::confinement).
 struct FrameSetup {
-  bool diametral = false; ///< a disk loaded across its diameter (y axis), else along the axis
-  double confinement = 0; ///< > 0: confining walls hold this stress [Pa]
-  double confinement_tolerance = 0.01; ///< the confining phase's band [-]
+  bool diametral = false;       ///< a disk loaded across its diameter (y axis), else along the axis
   Phase first_phase = kSeat;    ///< kConfine, kSeat (platens close to the seating stress) or kLoad
   double reverse_at_strain = 0; ///< > 0: unload from this axial strain back to zero [-]
 };
@@ -119,19 +117,18 @@ public:
   double separation() const;                  ///< platen or grip separation [m]
   std::int64_t load_start_step() const { return load_start_step_; }
   std::int64_t reverse_step() const { return reverse_step_; }
-  bool confined() const { return confinement_.mounted(); }
+  bool confined() const { return confinement_ != nullptr; }
+  /// The confining walls' stress [Pa] (0: not confined).
+  double confining_stress() const { return confinement_ ? confinement_->target() : 0.0; }
   const FrameSetup& frame_setup() const { return setup_; }
   const ConfinementBand& confinement_band() const { return band_; }
   bool loading() const { return phase_ >= kLoad; }
-  /// The platens lost the specimen while loading (a grain under a platen gave way and the load
-  /// collapsed): they close again with the seating servo to the seating stress, then load on at
-  /// the test's rate after the usual ramp. The peak and the curve so far stand.
-  void reseat();
-  bool reseating() const { return reseating_; }
-  int reseats() const { return reseats_; }
-  /// Since the last re-seating ended: the largest load [Pa] and the axial strain [-] travelled.
-  double reload_peak() const { return reload_peak_; }
-  double reload_strain() const { return current_.axial_strain - reload_strain0_; }
+  /// While loading, the platens close again with the seating servo to the seating stress, then
+  /// load on at the test's rate after the usual ramp; the peak and the curve so far stand. A test
+  /// asks for it when the platens lost the specimen (lab/protocols/brazilian_reseating.hpp).
+  /// False where it cannot: grips, not loading, or already seating again.
+  bool seat_again();
+  bool seating_again() const { return seating_again_; }
   /// The current cross-section [m^2] (confined: the walls'; else widened by the lateral strain).
   double current_area(double lateral_strain) const;
   /// The specimen's volume now [m^3] (2D: area x unit thickness): the current section times the
@@ -181,19 +178,16 @@ private:
   FrameSetup setup_;
   SpecimenGeometry geo_;
   // fixtures and gauges
-  std::unique_ptr<Actuator> actuator_; ///< platens, jaws or grips
-  ConfiningWalls confinement_;         ///< mounted when the test is confined
-  std::vector<std::int32_t> shell_;    ///< lateral-surface grains (the unconfined lateral gauge)
+  std::unique_ptr<Actuator> actuator_;          ///< platens, jaws or grips
+  std::unique_ptr<ConfiningWalls> confinement_; ///< the test's confining walls, if any
+  std::vector<std::int32_t> shell_; ///< lateral-surface grains (the unconfined lateral gauge)
   // state
   int phase_ = kSeat;
   std::int64_t phase_start_step_ = 0, load_start_step_ = 0, reverse_step_ = -1;
   std::int64_t ramp_start_step_ = 0; ///< the loading ramp's start (loading, or a re-seating's end)
   std::int64_t approach_end_step_ = -1; ///< the step the approach stress was reached (-1: not yet)
-  bool reseating_ = false;              ///< closing again to the seating stress while loading
-  std::int64_t reseat_step_ = 0;        ///< the step the last re-seating began
-  int reseats_ = 0;                     ///< re-seatings so far
-  double reload_peak_ = 0;              ///< largest load since the last re-seating ended [Pa]
-  double reload_strain0_ = 0;           ///< axial strain when the last re-seating ended [-]
+  bool seating_again_ = false;          ///< closing again to the seating stress while loading
+  std::int64_t seat_again_step_ = 0;    ///< the step the last seating again began
   double v_final_ = 0;                  ///< platen (grip) speed while loading [m/s]
   double sep_ref_ = 0;                  ///< platen or grip separation when loading began [m]
   std::vector<Vec3> shell_ref_;

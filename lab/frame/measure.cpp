@@ -18,8 +18,8 @@ double LoadingFrame::wall_height() const {
 }
 
 double LoadingFrame::current_area(double lateral_strain) const {
-  if (confinement_.mounted())
-    return confinement_.area(m_, geo_);
+  if (confinement_)
+    return confinement_->area(m_, geo_);
   // Unconfined: the initial section widened by the measured lateral strain.
   const double f = 1 - lateral_strain;
   return geo_.dim == 2 ? geo_.area0 * f : geo_.area0 * f * f;
@@ -33,9 +33,9 @@ double LoadingFrame::current_volume() const {
 
 double LoadingFrame::lateral_strain() const {
   // Compression positive (bulging is negative).
-  if (!confinement_.mounted())
+  if (!confinement_)
     return !shell_.empty() && shell_ref_.size() == shell_.size() ? shell_strain() : 0.0;
-  return confinement_.strain(m_, geo_);
+  return confinement_->strain(m_, geo_);
 }
 
 double LoadingFrame::shell_strain() const {
@@ -82,8 +82,7 @@ void LoadingFrame::measure(LabSample& s) const {
   const bool loading = phase_ >= kLoad;
   s.axial_strain = loading ? test_.axial_strain(*this) : 0.0;
   s.lateral_strain = loading && !geo_.diametral ? lateral_strain() : 0.0;
-  s.lateral_stress =
-      confinement_.mounted() ? confinement_.mean_stress(m_, geo_, wall_height()) : 0.0;
+  s.lateral_stress = confinement_ ? confinement_->mean_stress(m_, geo_, wall_height()) : 0.0;
   test_.stresses(*this, s);
 }
 

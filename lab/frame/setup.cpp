@@ -10,6 +10,7 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <stdexcept>
 
 namespace rocklab {
 
@@ -18,7 +19,8 @@ constexpr double kPi = std::numbers::pi;
 } // namespace
 
 LoadingFrame::LoadingFrame(const Protocol& p, FrameTest& test, Model& m, const nlohmann::json& meta)
-    : p_(p), test_(test), m_(m), meta_(meta), setup_(test.setup()), actuator_(test.actuator(p)) {}
+    : p_(p), test_(test), m_(m), meta_(meta), setup_(test.setup()), actuator_(test.actuator(p)),
+      confinement_(test.confinement()) {}
 
 void LoadingFrame::setup() {
   m_.settings.slip_events = false; // the lab reads bond_break events only
@@ -41,8 +43,10 @@ void LoadingFrame::setup() {
   m_.balls.track_orientation(p_.orientation); // rotations count from here, like displacements
   const LinearProps props = wall_contact();   // each fixture sets its own friction
   actuator_->mount(m_, geo_, props, p_.file);
-  if (setup.confinement > 0)
-    confinement_.mount(m_, geo_, props);
+  if (confinement_)
+    confinement_->mount(m_, geo_, props);
+  else if (setup.first_phase == kConfine)
+    throw std::logic_error("a test that starts by confining needs confining walls");
   find_shell();
   v_final_ =
       p_.platen_velocity > 0 ? p_.platen_velocity : 0.5 * p_.strain_rate * geo_.loaded_length();

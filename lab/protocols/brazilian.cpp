@@ -12,6 +12,7 @@
 // peak (crushed at the platens) (docs/protocol-format.md).
 #include "lab/protocols/brazilian.hpp"
 #include "lab/frame/frame_test.hpp"
+#include "lab/protocols/brazilian_reseating.hpp"
 #include "lab/protocols/tensile_strength.hpp"
 
 #include "io/json_input.hpp"
@@ -115,7 +116,8 @@ public:
   // read (the largest load before the loss): the halves then carry the platens as columns, which
   // says nothing more about the rock, so the test ends without waiting for the load to fall.
   std::string stop_while_loading(LoadingFrame& f) override {
-    if (split_fraction_ <= 0 || f.reseating() || !watch_ || watch_->lost().step < 0 ||
+    reseating_.track(f);
+    if (split_fraction_ <= 0 || f.seating_again() || !watch_ || watch_->lost().step < 0 ||
         !split_seen(f))
       return "";
     return "the disk split and lost the tension across its loaded diameter";
@@ -125,18 +127,20 @@ public:
     // along the loaded diameter ends the test, or a load collapse below failed_fraction that
     // re-seating the platens does not cure.
     const Protocol& p = f.protocol();
+    reseating_.track(f);
     if (split_fraction_ <= 0)
       return load_fell_reason(p);
     if (split_seen(f))
       return "the disk split and the load fell below " + format_double(p.post_peak_fraction) +
              " of its peak";
-    if (f.reseating())
+    if (f.seating_again())
       return "";
     // A disk that lost load without a split and is pressed on without one is being crushed at
     // the platens (the 3D parallel-bonded suite's disk: 0.7 of its peak at 2.25 % of D, 688,137
     // steps, heading for stop.max_steps, about 11 h); a lab would stop the machine. After a
     // re-seating the travel counts from where reloading began.
-    const double travel = f.reseats() > 0 ? f.reload_strain() : f.current().axial_strain;
+    const int reseats = reseating_.count();
+    const double travel = reseats > 0 ? reseating_.reload_strain(f) : f.current().axial_strain;
     if (travel_multiple_ > 0 && travel > travel_multiple_ * f.peak().strain)
       return "no split along the loaded diameter within " + format_double(travel_multiple_) +
              " times the platen travel to the peak (crushing at the platens)";
@@ -148,22 +152,22 @@ public:
     // loads nothing (the fifth 2D acceptance run's seed 3: 5 MPa to 0.05 MPa in 800 steps with
     // one new crack). The platens close again (at the seating servo's speed, not the test's)
     // and load on; once reloaded, a new collapse is a new re-seating, at most kMaxReseats.
-    const bool reloaded = f.reseats() == 0 || f.reload_peak() >= low;
-    if (reloaded && f.reseats() < kMaxReseats) {
-      f.reseat();
+    const bool reloaded = reseats == 0 || reseating_.reload_peak() >= low;
+    if (reloaded && reseats < kMaxReseats) {
+      reseating_.reseat(f);
       return "";
     }
     // Reloading after a re-seating: give it the platen travel the disk needed to its peak.
-    if (!reloaded && f.reload_strain() < f.peak().strain)
+    if (!reloaded && reseating_.reload_strain(f) < f.peak().strain)
       return "";
     return "the load fell below " + format_double(failed_fraction_) +
            " of its peak without a split along the loaded diameter" +
-           (f.reseats() > 0 ? " (platens re-seated " + std::to_string(f.reseats()) + " times)"
-                            : std::string());
+           (reseats > 0 ? " (platens re-seated " + std::to_string(reseats) + " times)"
+                        : std::string());
   }
   void results(const LoadingFrame& f, nlohmann::json& r) const override {
     const PeakRecord& peak = f.peak();
-    r["platen_reseats"] = f.reseats(); // collapses without a split that re-seating cured
+    r["platen_reseats"] = reseating_.count(); // collapses without a split that re-seating cured
     if (flat_angle_ > 0)
       r["flats"] = {{"loading_angle_deg", flat_angle_ * 180 / std::numbers::pi},
                     {"stress_factor", flat_disk_factor(flat_angle_)},
@@ -369,6 +373,7 @@ public:
     for (const TensionReading& x : tension_)
       t.push_back({x.step, x.load, x.ratio, x.arc, x.contacts, x.cracks, x.strain});
     state["diametral_tension"] = std::move(t);
+    reseating_.save(state);
   }
   void load(const nlohmann::json& state, const std::string& file) override {
     tension_.clear();
@@ -386,8 +391,10 @@ public:
           throw std::domain_error("not finite");
         tension_.push_back(t);
       }
+      reseating_.load(state);
     } catch (const std::exception&) {
-      throw InputError(file + ": corrupt checkpoint (Brazilian 'diametral_tension' readings)");
+      throw InputError(
+          file + ": corrupt checkpoint (Brazilian 'diametral_tension' readings or 'reseating')");
     }
     bins_.reset();
     watch_.reset(); // fed again from the restored readings at the next one
@@ -468,6 +475,7 @@ private:
   bool split_ = false;                  ///< the binned cracks make a split
   std::vector<TensionReading> tension_; ///< the diametral tension per unit force while loading
   std::optional<TensionWatch> watch_;   ///< its loss, watched while loading
+  PlatenReseating reseating_;           ///< the platens seated again after a collapse
   // options
   double jaw_ratio_ = 0;         ///< curved jaws of this times the disk's radius; 0: flat platens
   double cushion_ = 1;           ///< platen contact stiffness over the specimen's wall contact

@@ -85,11 +85,10 @@ void CompressionTest::results(const LoadingFrame& f, nlohmann::json& r) const {
   r["peak_deviator_Pa"] = peak.load;
   r["peak_axial_strain"] = peak.strain;
   r["peak_lateral_strain"] = peak.lateral;
-  const FrameSetup& setup = f.frame_setup();
-  r["confinement_Pa"] = setup.confinement;
+  r["confinement_Pa"] = f.confining_stress();
   if (f.confined())
-    r["confinement_measured_Pa"] = f.confinement_band().json(setup.confinement);
-  if (setup.reverse_at_strain > 0)
+    r["confinement_measured_Pa"] = f.confinement_band().json(f.confining_stress());
+  if (f.frame_setup().reverse_at_strain > 0)
     unloading_moduli(f, r);
 }
 

@@ -22,10 +22,11 @@ public:
   }
   FrameSetup setup() const override {
     FrameSetup s = compression_setup();
-    s.confinement = confinement_;
-    s.confinement_tolerance = tolerance_;
     s.first_phase = kConfine;
     return s;
+  }
+  std::unique_ptr<ConfiningWalls> confinement() const override {
+    return std::make_unique<ConfiningWalls>(confinement_, tolerance_);
   }
   // The strength envelope through the UCS and the triaxial peaks (Hoek-Brown needs two).
   std::vector<SuiteProperty> suite_properties() const override {
