@@ -166,6 +166,26 @@ TEST(MaterialCard, KeysGenesisSetsAndMissingStiffnessAreRefusedNamingTheKey) {
   EXPECT_NE(card_error(card_with("flatjoint", nal)).find("3D property"), std::string::npos);
 }
 
+TEST(MaterialCard, ADrawnStrengthIsTheModelsOwnKeyWithItsRangeAndDefault) {
+  // The card's {"mean", "sd"} goes through the model's reader: its range names the key...
+  const std::string negative = card_error(card_with(
+      "flatjoint", {{"fj_emod", 1e9}, {"fj_ten", {{"mean", -1.0}, {"sd", 0.0}}}, {"fj_coh", 1e6}}));
+  EXPECT_NE(negative.find("'flatjoint.fj_ten'"), std::string::npos) << negative;
+  EXPECT_NE(negative.find("[0, +inf)"), std::string::npos) << negative;
+  const std::string sd = card_error(
+      card_with("parallelbond",
+                {{"pb_emod", 1e9}, {"pb_ten", 1e6}, {"pb_coh", {{"mean", 1e6}, {"sd", -1.0}}}}));
+  EXPECT_NE(sd.find("'parallelbond.pb_coh.sd'"), std::string::npos) << sd;
+  // ... and a key the card leaves out takes the model's default, as in a scene (no sd).
+  const MaterialCard c = load_material_card(
+      card_with("flatjoint", {{"fj_emod", 1e9}, {"fj_coh", {{"mean", 2e6}, {"sd", 3e5}}}}));
+  const auto& fj = bond_section<FlatJointProps>(c);
+  EXPECT_EQ(fj.dist.at("fj_ten").mean, scene_read<FlatJoint>({{"fj_emod", 1e9}}, 3).fj_ten);
+  EXPECT_EQ(fj.dist.at("fj_ten").sd, 0.0);
+  EXPECT_EQ(fj.dist.at("fj_coh").mean, 2e6);
+  EXPECT_EQ(fj.dist.at("fj_coh").sd, 3e5);
+}
+
 TEST(MaterialCard, FactorsAContactDividesByHaveAPositiveLowerBound) {
   // fuzz finding: fj_rmul = 1e-320 was accepted and the run ended with a NaN energy ledger.
   json fj = {{"fj_emod", 1e9}, {"fj_ten", 1e6}, {"fj_coh", 1e6}, {"fj_rmul", 1e-320}};

@@ -21,6 +21,19 @@ Distribution read_distribution(JsonObject& o, const std::string& key, const char
   return d;
 }
 
+double take_card_sd(nlohmann::json& keys, const std::string& file, const std::string& path,
+                    const char* key, const char* unit) {
+  const auto it = keys.find(key);
+  if (it == keys.end() || !it->is_object())
+    return 0;
+  JsonObject d(*it, file, path + "." + key);
+  const double mean = d.number("mean", Range::any(), std::nullopt, unit); // the model's range
+  const double sd = d.number("sd", Range::non_negative(), 0.0, unit);
+  d.finish();
+  *it = mean;
+  return sd;
+}
+
 nlohmann::json card_model_keys(JsonObject& top, const std::string& section,
                                const std::string& prefix,
                                std::initializer_list<const char*> card_keys) {

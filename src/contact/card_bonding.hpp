@@ -28,8 +28,21 @@ struct Distribution {
 };
 
 /// A card's distribution: a number (sd 0) or {"mean", "sd"} in `unit`, both >= 0; errors name the
-/// file and key.
+/// file and key. For a key of a bonded model's own section, see read_card_section's drawn keys.
 Distribution read_distribution(JsonObject& o, const std::string& key, const char* unit);
+
+/// A key of a model's card section drawn per contact: the model's number or {"mean", "sd"}
+/// around it (`field`: where the model's reader puts the number).
+template <class M> struct DrawnKey {
+  const char* key;
+  double M::Props::*field;
+  const char* unit;
+};
+
+/// A drawn key given as {"mean", "sd"}: the sd [unit, >= 0] is taken and `keys[key]` becomes the
+/// mean, which the model's own reader then reads; a number or no key: sd 0.
+double take_card_sd(nlohmann::json& keys, const std::string& file, const std::string& path,
+                    const char* key, const char* unit);
 
 /// The random values of one bond candidate: from the run's stream (the candidates shuffled) or
 /// from a stream of the contact's own (`installation.draws`, materials/genesis/finalization.cpp).
@@ -78,16 +91,29 @@ nlohmann::json card_model_keys(JsonObject& top, const std::string& section,
 
 /// Read a card section holding a contact model's properties: its model keys (all with `prefix`
 /// in a bond section) by the model's own reader, the one a scene's contact_models entry uses
-/// (one reader, one default per key), leaving out `card_keys` (distributions, types), which the
-/// section's caller reads itself.
+/// (one reader, one default per key), leaving out `card_keys` (types), which the section's caller
+/// reads itself. Each of the `drawn` keys (a strength drawn per contact) is the model's own key:
+/// its mean goes through the model's reader (range, default) and `drawn_out` receives the
+/// distributions in the same order.
 template <class M>
 typename M::Props read_card_section(JsonObject& top, const std::string& section, int dim,
                                     const std::string& prefix,
-                                    std::initializer_list<const char*> card_keys) {
-  const nlohmann::json keys = card_model_keys(top, section, prefix, card_keys);
-  JsonObject m(keys, top.file(), top.key_path(section));
-  typename M::Props p = M::read(m, dim);
-  m.finish();
+                                    std::initializer_list<const char*> card_keys,
+                                    std::initializer_list<DrawnKey<M>> drawn = {},
+                                    std::vector<Distribution>* drawn_out = nullptr) {
+  nlohmann::json keys = card_model_keys(top, section, prefix, card_keys);
+  std::vector<double> sd;
+  for (const DrawnKey<M>& d : drawn)
+    sd.push_back(take_card_sd(keys, top.file(), top.key_path(section), d.key, d.unit));
+  JsonObject model(keys, top.file(), top.key_path(section));
+  typename M::Props p = M::read(model, dim);
+  model.finish();
+  if (drawn_out) {
+    drawn_out->clear();
+    std::size_t i = 0;
+    for (const DrawnKey<M>& d : drawn)
+      drawn_out->push_back({p.*(d.field), sd[i++]});
+  }
   return p;
 }
 

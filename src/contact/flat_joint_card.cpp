@@ -16,7 +16,13 @@ namespace {
 class FlatJointCard final : public CardBonding {
 public:
   FlatJointCard(JsonObject& top, int dim) {
-    fj_ = read_card_section<FlatJoint>(top, "flatjoint", dim, "fj_", {"fj_ten", "fj_coh", "types"});
+    std::vector<Distribution> drawn;
+    fj_ = read_card_section<FlatJoint>(
+        top, "flatjoint", dim, "fj_", {"types"},
+        {{"fj_ten", &FlatJointProps::fj_ten, "Pa"}, {"fj_coh", &FlatJointProps::fj_coh, "Pa"}},
+        &drawn);
+    ten_ = drawn[0];
+    coh_ = drawn[1];
     JsonObject f = top.object("flatjoint");
     if (!(fj_.fj_emod > 0 || fj_.fj_kn > 0))
       f.fail("fj_emod", "missing: a card's flat joints need a stiffness (fj_emod with fj_kratio, "
@@ -24,8 +30,6 @@ public:
     if (f.has("fj_gap0"))
       f.fail("fj_gap0", "is set by genesis on a card: give the gapped contacts' gap as "
                         "'types.gap'");
-    ten_ = read_distribution(f, "fj_ten", "Pa");
-    coh_ = read_distribution(f, "fj_coh", "Pa");
     JsonObject t = f.optional_object("types");
     fractions_ = {t.number("bonded", Range::closed(0, 1), 1.0),
                   t.number("gapped", Range::closed(0, 1), 0.0),

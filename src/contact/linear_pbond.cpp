@@ -190,13 +190,17 @@ namespace {
 class ParallelBondCard final : public CardBonding {
 public:
   ParallelBondCard(JsonObject& top, int dim) {
-    pb_ = read_card_section<LinearPBond>(top, "parallelbond", dim, "pb_", {"pb_ten", "pb_coh"});
+    std::vector<Distribution> drawn;
+    pb_ = read_card_section<LinearPBond>(
+        top, "parallelbond", dim, "pb_", {},
+        {{"pb_ten", &LinearPBondProps::pb_ten, "Pa"}, {"pb_coh", &LinearPBondProps::pb_coh, "Pa"}},
+        &drawn);
+    ten_ = drawn[0];
+    coh_ = drawn[1];
     JsonObject p = top.object("parallelbond");
     if (!(pb_.pb_emod > 0 || pb_.pb_kn > 0))
       p.fail("pb_emod", "missing: a card's parallel bonds need a stiffness (pb_emod with "
                         "pb_kratio, or pb_kn with pb_ks)");
-    ten_ = read_distribution(p, "pb_ten", "Pa");
-    coh_ = read_distribution(p, "pb_coh", "Pa");
   }
   // Draws: tension, then cohesion.
   CardBond bond(BondDraws& d, const BondSite& site) const override {
