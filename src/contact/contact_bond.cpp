@@ -49,12 +49,16 @@ namespace {
 
 class ContactBondCard final : public CardBonding {
 public:
-  explicit ContactBondCard(JsonObject& top) {
-    // PFC's contact bond on the linear contact: point-bond strengths in force units.
-    JsonObject b = top.object("contactbond");
-    tenf_ = read_distribution(b, "cb_tenf", "N");
-    shearf_ = read_distribution(b, "cb_shearf", "N");
-    b.finish();
+  ContactBondCard(JsonObject& top, int dim) {
+    // PFC's contact bond on the linear contact: point-bond strengths in force units, the
+    // model's own keys (its reader: range and default), drawn per contact.
+    std::vector<Distribution> drawn;
+    read_card_section<ContactBond>(top, "contactbond", dim, "cb_", {},
+                                   {{"cb_tenf", &ContactBondProps::cb_tenf, "N"},
+                                    {"cb_shearf", &ContactBondProps::cb_shearf, "N"}},
+                                   &drawn);
+    tenf_ = drawn[0];
+    shearf_ = drawn[1];
   }
   // Draws: the tensile, then the shear strength force.
   CardBond bond(BondDraws& d, const BondSite& site) const override {
@@ -82,8 +86,8 @@ private:
 
 } // namespace
 
-std::unique_ptr<CardBonding> ContactBond::card_bonding(JsonObject& top, int) {
-  return std::make_unique<ContactBondCard>(top);
+std::unique_ptr<CardBonding> ContactBond::card_bonding(JsonObject& top, int dim) {
+  return std::make_unique<ContactBondCard>(top, dim);
 }
 
 nlohmann::json ContactBond::state_json(const Contact& cb, int) {
