@@ -431,6 +431,15 @@ TEST(CalibrationFile, BadFilesNameTheKeyAndWhatIsAllowed) {
     j["parameters"][bad] = {{"role", "strength"}, {"bounds", {0.1, 10}}};
     EXPECT_NE(error_of(j).find("with no empty side"), std::string::npos) << bad << error_of(j);
   }
+  // A bound the model's own reader refuses (a stiffness ratio between 0 and 1e-3) is named with
+  // the parameter before any genesis runs; one within its range loads.
+  j = good_calibration();
+  j["parameters"]["flatjoint.fj_kratio"]["bounds"] = {1e-9, 5.0};
+  EXPECT_NE(error_of(j).find("parameters.flatjoint.fj_kratio.bounds"), std::string::npos)
+      << error_of(j);
+  EXPECT_NE(error_of(j).find("fj_kratio"), std::string::npos) << error_of(j);
+  j["parameters"]["flatjoint.fj_kratio"]["bounds"] = {1e-3, 5.0};
+  EXPECT_EQ(error_of(j), "");
   // A material path that is not a card is named with the calibration file's key.
   j = good_calibration();
   j["material"] = "/dev/zero";

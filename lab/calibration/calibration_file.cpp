@@ -207,6 +207,25 @@ nlohmann::json read_extended(const std::string& path, std::string& material_from
   return merged;
 }
 
+// Each parameter at each end of its bounds (the others at their start) gives a card the card
+// reader takes: a bound beyond what the model's own reader allows (a stiffness ratio below its
+// 1e-3, a fraction past 1) is refused here, naming the parameter, not at a genesis hours later.
+// Ratios keep their denominator's start.
+void check_bounds_readable(const CalibrationFile& c, const std::string& path) {
+  std::vector<double> start;
+  for (const CardParam& p : c.params)
+    start.push_back(p.param.value);
+  for (std::size_t i = 0; i < c.params.size(); ++i)
+    for (const double end : {c.params[i].param.lo, c.params[i].param.hi}) {
+      std::vector<double> v = start;
+      v[i] = end;
+      const std::string name = c.material_file + " (parameter at " + format_double(end) + ")";
+      const InputText card(name, apply_params(c.material, c.params, v).dump());
+      named_by(path, "parameters." + c.params[i].key + ".bounds",
+               [&] { return load_material_card(name); });
+    }
+}
+
 } // namespace
 
 CalibrationFile load_calibration(const std::string& path) {
@@ -235,6 +254,7 @@ CalibrationFile load_calibration(const std::string& path) {
           return q.over.empty() && q.path == p.over;
         }))
       params.fail(p.key, "a ratio's denominator \"" + p.over + "\" must be a free parameter too");
+  check_bounds_readable(c, path);
   for (const auto& [t, tpath] : top.array("tests"))
     c.tests.push_back(*t);
   check_coverage(c, top);

@@ -38,7 +38,8 @@ public:
     if (std::abs(sum - 1) > 1e-9)
       t.fail("bonded", "the fractions bonded + gapped + slit must sum to 1 (they sum to " +
                            std::to_string(sum) + ")");
-    if (fractions_[1] > 0)
+    // A gapped fraction of 0 may keep its gap (a calibration moving the fraction to its bound).
+    if (fractions_[1] > 0 || t.has("gap"))
       gap_ = read_distribution(t, "gap", "m");
     t.finish();
   }
