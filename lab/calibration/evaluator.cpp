@@ -201,6 +201,28 @@ void Evaluator::adopt_seeds(const std::vector<std::uint64_t>& seeds) {
       seeds_.push_back(s);
 }
 
+namespace {
+
+// The cache key of one replicate: everything its result depends on (the card, the tests with
+// their seed, written to `ts`, the version), with the revision of each test's measurement rules
+// where it was raised (older keys stay valid for the other tests).
+std::string cache_key(const nlohmann::json& card, const nlohmann::json& tests, std::uint64_t seed,
+                      nlohmann::json& ts) {
+  std::string revisions;
+  for (const auto& t : tests)
+    if (const auto p = make_lab_protocol(t.value("test", "")); p && p->revision() > 1) {
+      revisions += '|';
+      revisions += p->name();
+      revisions += " r" + std::to_string(p->revision());
+    }
+  ts = tests;
+  for (auto& t : ts)
+    t["seed"] = seed;
+  return text_hash(card.dump() + "|" + ts.dump() + "|" + ROCKLAB_VERSION + revisions).substr(0, 16);
+}
+
+} // namespace
+
 Evaluation Evaluator::run(const std::vector<double>& values, Stage s, std::size_t seeds) {
   const std::vector<std::uint64_t> first(
       seeds_.begin(), seeds_.begin() + static_cast<std::ptrdiff_t>(std::min(seeds, seeds_.size())));
@@ -211,21 +233,8 @@ Evaluation Evaluator::run_on(const std::vector<double>& values, Stage s,
                              const std::vector<std::uint64_t>& seeds) {
   const nlohmann::json card = apply_params(c_.material, c_.params, values);
   const nlohmann::json stage_tests = tests_of(s);
-  // The cache key: everything the result depends on, with the revision of each test's measurement
-  // rules where it was raised (older keys stay valid for the other tests).
   auto key_of = [&](const nlohmann::json& tests, std::uint64_t seed, nlohmann::json& ts) {
-    std::string revisions;
-    for (const auto& t : tests)
-      if (const auto p = make_lab_protocol(t.value("test", "")); p && p->revision() > 1) {
-        revisions += '|';
-        revisions += p->name();
-        revisions += " r" + std::to_string(p->revision());
-      }
-    ts = tests;
-    for (auto& t : ts)
-      t["seed"] = seed;
-    return text_hash(card.dump() + "|" + ts.dump() + "|" + ROCKLAB_VERSION + revisions)
-        .substr(0, 16);
+    return cache_key(card, tests, seed, ts);
   };
   const fs::path evaluations = fs::path(o_.out_dir) / "evaluations";
   std::vector<Replicate> reps;
