@@ -111,7 +111,6 @@ public:
   double target() const { return target_; }       ///< the confining stress [Pa]
   double tolerance() const { return tolerance_; } ///< the confining phase's band [-]
   void mount(Model& m, const SpecimenGeometry& g, const LinearProps& contact);
-  bool mounted() const { return !walls_.empty(); }
   const std::vector<std::int64_t>& walls() const { return walls_; }
   /// The mean stress on the walls [Pa]; `height`: the specimen's height now [m].
   double mean_stress(const Model& m, const SpecimenGeometry& g, double height) const;
